@@ -1,0 +1,33 @@
+// A simple capture generator (until the full simulator): a camera moving over a printed AprilTag,
+// rendered by inverse-mapping every pixel through the camera model onto the tag plane, with
+// exact ground-truth poses. Writes a format-v1 recording.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+#include "core/pixel_format.h"
+
+namespace arpipe {
+
+struct TagCaptureOptions {
+  int width = 640;
+  int height = 480;
+  std::string lensmodel = "LENSMODEL_OPENCV4";  // mild distortion so the lens path is exercised
+  int frames = 60;
+  double fps = 30.0;
+  int64_t exposure_ns = 4'000'000;
+  PixelFormat pixel_format = PixelFormat::YUYV;
+  std::string family = "tag36h11";
+  int tag_id = 0;
+  double tag_size_m = 0.1;  // black-border edge, as AprilTag measures it
+  uint64_t seed = 1;        // noise seed
+  double noise_sigma = 1.0; // 8-bit units
+};
+
+// Generates the recording into dir (which must not exist). Returns the number of frames written.
+// Throws std::runtime_error with a clear message on bad options.
+int generate_tag_capture(const std::filesystem::path& dir, const TagCaptureOptions& options);
+
+}  // namespace arpipe

@@ -1,0 +1,29 @@
+# Every external dependency, found once (packages listed in scripts/install-deps.sh).
+find_package(PkgConfig REQUIRED)
+find_package(Threads REQUIRED)
+find_package(OpenCV 4 REQUIRED COMPONENTS core imgproc calib3d imgcodecs)
+find_package(apriltag REQUIRED)
+find_package(nlohmann_json 3 REQUIRED)
+find_package(ZLIB REQUIRED)
+find_package(fmt REQUIRED)
+pkg_check_modules(TOMLPP REQUIRED IMPORTED_TARGET tomlplusplus)
+pkg_check_modules(SYSTEMD REQUIRED IMPORTED_TARGET libsystemd)
+pkg_check_modules(EGL REQUIRED IMPORTED_TARGET egl)
+pkg_check_modules(GLES REQUIRED IMPORTED_TARGET glesv2)
+
+# mrcal ships no pkg-config or CMake file; -lmrcal pulls in libdogleg and CHOLMOD.
+find_library(MRCAL_LIBRARY mrcal REQUIRED)
+find_path(MRCAL_INCLUDE_DIR mrcal/mrcal.h REQUIRED)
+add_library(mrcal::mrcal UNKNOWN IMPORTED)
+set_target_properties(mrcal::mrcal PROPERTIES IMPORTED_LOCATION ${MRCAL_LIBRARY}
+  INTERFACE_INCLUDE_DIRECTORIES ${MRCAL_INCLUDE_DIR})
+
+# tinygltf is header-only in Debian (tiny_gltf.h); it needs stb and nlohmann json.
+find_path(TINYGLTF_INCLUDE_DIR tiny_gltf.h PATH_SUFFIXES tinygltf REQUIRED)
+
+if(ARPIPE_BUILD_TESTS)
+  find_package(GTest REQUIRED)
+endif()
+if(ARPIPE_BUILD_BENCH)
+  find_package(benchmark REQUIRED)
+endif()

@@ -1,0 +1,10 @@
+# Warnings for our own targets only (arpipe_warnings is linked PRIVATE by every target).
+add_library(arpipe_warnings INTERFACE)
+target_compile_options(arpipe_warnings INTERFACE -Wall -Wextra -Wpedantic)
+if(ARPIPE_WERROR)
+  target_compile_options(arpipe_warnings INTERFACE -Werror)
+endif()
+if(ARPIPE_SANITIZE)
+  add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
+  add_link_options(-fsanitize=address,undefined)
+endif()

@@ -1,0 +1,121 @@
+// The daemon's configuration: a TOML file where every key has a default and unknown keys are errors.
+// Degrees appear only here, at the boundary; the structs hold radians and metres.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "core/geometry/vec.h"
+
+namespace arpipe {
+
+// Bad config input; what() names the file, the line and column where known, and what was expected.
+class ConfigError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct SourceConfig {
+  std::string type = "replay";          // "replay" (more sources come with the live-capture issue)
+  std::filesystem::path path;           // replay: the recording directory
+  std::string pacing = "timestamps";    // replay: "timestamps" (real time) or "fast"
+  bool loop = false;                    // replay: start again at the end (soak tests)
+  int64_t timestamp_offset_ns = 0;      // added to every exposure_start_ns of this camera
+  std::filesystem::path camera_model;   // overrides the recording's camera model when set
+};
+
+// One tag of the anchor bundle: where its centre sits in the world (anchor) frame and how it is turned.
+struct BundleTag {
+  int id = 0;
+  double size_m = 0.1;      // edge between the black and white borders (AprilTag's "tag size")
+  Vec3 center_m{0, 0, 0};   // tag centre in the world frame
+  double yaw_rad = 0;       // rotation about world z of the tag's x axis; tags lie in the z=0 plane
+};
+
+struct TrackConfig {
+  bool enabled = true;
+  std::string family = "tag36h11";
+  std::vector<BundleTag> bundle{BundleTag{}};  // default: tag 0, 10 cm, at the origin
+  double quad_decimate = 2.0;
+  double quad_sigma = 0.0;
+  int threads = 1;
+  int max_hamming = 1;
+  double min_decision_margin = 20.0;
+  // IPPE returns two poses for a planar target; when their reprojection errors are within this
+  // ratio the choice is ambiguous and temporal consistency decides.
+  double ambiguity_ratio = 3.0;
+};
+
+struct SceneObject {
+  std::string mesh = "builtin:cube";   // "builtin:cube", "builtin:pyramid", or a glTF 2.0 file
+  Vec3 position_m{0, 0, 0};            // in the world (anchor) frame
+  double yaw_rad = 0;                  // about world z
+  double scale = 1.0;
+  Vec3 color{0.8, 0.3, 0.1};           // linear base colour for builtin meshes
+};
+
+struct RenderConfig {
+  bool enabled = true;
+  std::vector<SceneObject> objects{SceneObject{}};
+  Vec3 light_direction{0.3, -0.4, 1.0};  // world frame, pointing towards the light (normalised at load)
+  Vec3 light_color{1.0, 1.0, 1.0};       // linear
+  Vec3 ambient{0.25, 0.25, 0.25};        // linear
+  int msaa_samples = 4;
+  std::string egl_platform = "auto";     // "auto", "surfaceless", "device"
+};
+
+struct PngSinkConfig {
+  bool enabled = true;
+  std::filesystem::path dir = "out/png";
+  int every = 1;  // write every Nth frame
+};
+struct Y4mSinkConfig {
+  bool enabled = true;
+  std::filesystem::path path = "out/arpiped.y4m";
+};
+struct RecordingSinkConfig {
+  bool enabled = false;
+  std::filesystem::path path = "out/composited";
+};
+struct ResultsSinkConfig {
+  bool enabled = true;
+  std::filesystem::path path = "out/results.jsonl";  // per-frame pose, tracking state, timings
+};
+
+struct SinksConfig {
+  PngSinkConfig png;
+  Y4mSinkConfig y4m;
+  RecordingSinkConfig recording;
+  ResultsSinkConfig results;
+};
+
+struct PipelineConfig {
+  int queue_depth = 4;
+  int64_t max_frames = 0;  // 0 = no limit
+  std::string log_level = "info";
+};
+
+struct Config {
+  std::filesystem::path file;  // where it came from, for messages
+  SourceConfig source;
+  TrackConfig track;
+  RenderConfig render;
+  SinksConfig sinks;
+  PipelineConfig pipeline;
+};
+
+// Loads a config file. Throws ConfigError naming the file and the place on any problem:
+// unreadable file, TOML syntax, unknown key, wrong type, value out of range.
+// overrides: "section.key=value" assignments (value in TOML syntax) from the command line,
+// applied before validation, so they are checked like the file.
+Config load_config(const std::filesystem::path& path, const std::vector<std::string>& overrides = {});
+// Parses TOML text; source_name is used in messages.
+Config parse_config(const std::string& text, const std::string& source_name,
+                    const std::vector<std::string>& overrides = {});
+// The config with every key at its default, as TOML text (what `arpipe config --defaults` prints).
+std::string default_config_toml();
+
+}  // namespace arpipe

@@ -1,0 +1,42 @@
+#include "core/frame.h"
+
+namespace arpipe {
+
+std::string_view timestamp_meaning_name(TimestampMeaning meaning) {
+  switch (meaning) {
+    case TimestampMeaning::StartOfExposure: return "start_of_exposure";
+    case TimestampMeaning::EndOfFrame: return "end_of_frame";
+    case TimestampMeaning::Sensor: return "sensor";
+  }
+  return "?";
+}
+
+bool timestamp_meaning_from_name(std::string_view name, TimestampMeaning& out) {
+  for (auto m : {TimestampMeaning::StartOfExposure, TimestampMeaning::EndOfFrame, TimestampMeaning::Sensor}) {
+    if (timestamp_meaning_name(m) == name) {
+      out = m;
+      return true;
+    }
+  }
+  return false;
+}
+
+int64_t exposure_start_from_raw(int64_t raw_ns, TimestampMeaning meaning, int64_t exposure_ns, int64_t readout_ns,
+                                int64_t offset_ns) {
+  int64_t start = raw_ns;
+  // End of frame is when the last row finished: it started exposing readout_ns after the first row.
+  if (meaning == TimestampMeaning::EndOfFrame) start = raw_ns - exposure_ns - readout_ns;
+  return start + offset_ns;
+}
+
+Frame Frame::allocate(PixelFormat format, int width, int height) {
+  Frame f;
+  f.format = format;
+  f.width = width;
+  f.height = height;
+  f.bytes_per_line = min_bytes_per_line(format, width);
+  f.data.resize(image_bytes(format, width, height, f.bytes_per_line));
+  return f;
+}
+
+}  // namespace arpipe

@@ -1,0 +1,57 @@
+// A camera frame: pixels in the source's own format plus the exposure metadata of DESIGN.md.
+// Timestamps are int64 nanoseconds on CLOCK_MONOTONIC.
+#pragma once
+
+#include <cstdint>
+#include <string_view>
+#include <vector>
+
+#include "core/pixel_format.h"
+
+namespace arpipe {
+
+// What a source's raw timestamp meant before it was normalised to exposure_start_ns.
+enum class TimestampMeaning {
+  StartOfExposure,  // first row started exposing (libcamera SensorTimestamp, V4L2 SOE)
+  EndOfFrame,       // last row was read out (V4L2 EOF, most UVC drivers)
+  Sensor,           // sensor-defined; treated as start of exposure plus the configured offset
+};
+std::string_view timestamp_meaning_name(TimestampMeaning meaning);
+bool timestamp_meaning_from_name(std::string_view name, TimestampMeaning& out);
+
+struct FrameMetadata {
+  uint64_t sequence = 0;            // source sequence number; gaps are dropped frames
+  int64_t exposure_start_ns = 0;    // CLOCK_MONOTONIC time the first row started exposing
+  int64_t exposure_ns = 0;          // exposure time of one row
+  int64_t readout_ns = 0;           // first-row to last-row readout time; 0 for a global shutter
+  int64_t frame_duration_ns = 0;    // nominal frame interval
+  double analogue_gain = 1.0;
+  double digital_gain = 1.0;
+  int64_t raw_timestamp_ns = 0;     // the source's timestamp as it gave it
+  TimestampMeaning raw_timestamp_meaning = TimestampMeaning::StartOfExposure;
+  int64_t timestamp_offset_ns = 0;  // per-camera offset applied while normalising
+
+  // Middle of the exposure of the middle row: where a single pose for the frame belongs.
+  int64_t exposure_mid_ns() const { return exposure_start_ns + (exposure_ns + readout_ns) / 2; }
+  double total_gain() const { return analogue_gain * digital_gain; }
+};
+
+// Turns a raw source timestamp into exposure_start_ns per DESIGN.md:
+// end of frame minus exposure and readout; plus the configured per-camera offset.
+int64_t exposure_start_from_raw(int64_t raw_ns, TimestampMeaning meaning, int64_t exposure_ns,
+                                int64_t readout_ns, int64_t offset_ns);
+
+struct Frame {
+  FrameMetadata meta;
+  PixelFormat format = PixelFormat::RGB24;
+  int width = 0;
+  int height = 0;
+  size_t bytes_per_line = 0;  // stride of the first plane (NV12's UV plane has the same stride)
+  std::vector<uint8_t> data;
+
+  // Allocates an image of this format and size with the minimum stride.
+  static Frame allocate(PixelFormat format, int width, int height);
+  bool empty() const { return data.empty(); }
+};
+
+}  // namespace arpipe

@@ -1,0 +1,140 @@
+#include "core/image/pixel_convert.h"
+
+#include <algorithm>
+#include <cstring>
+
+namespace arpipe {
+
+namespace {
+inline uint8_t clamp8(int v) { return static_cast<uint8_t>(std::clamp(v, 0, 255)); }
+
+// BT.601 limited range, integer form (16.16-free, 8-bit fixed point as in libyuv).
+inline void yuv_to_rgb(int y, int u, int v, uint8_t* rgb) {
+  const int c = 298 * (y - 16);
+  const int d = u - 128;
+  const int e = v - 128;
+  rgb[0] = clamp8((c + 409 * e + 128) >> 8);
+  rgb[1] = clamp8((c - 100 * d - 208 * e + 128) >> 8);
+  rgb[2] = clamp8((c + 516 * d + 128) >> 8);
+}
+inline uint8_t rgb_to_y(int r, int g, int b) { return clamp8(((66 * r + 129 * g + 25 * b + 128) >> 8) + 16); }
+inline uint8_t rgb_to_u(int r, int g, int b) { return clamp8(((-38 * r - 74 * g + 112 * b + 128) >> 8) + 128); }
+inline uint8_t rgb_to_v(int r, int g, int b) { return clamp8(((112 * r - 94 * g - 18 * b + 128) >> 8) + 128); }
+}  // namespace
+
+void to_grey(const Frame& f, std::vector<uint8_t>& out) {
+  out.resize(size_t(f.width) * f.height);
+  for (int y = 0; y < f.height; ++y) {
+    const uint8_t* row = f.data.data() + size_t(y) * f.bytes_per_line;
+    uint8_t* dst = out.data() + size_t(y) * f.width;
+    switch (f.format) {
+      case PixelFormat::GREY:
+      case PixelFormat::NV12: std::memcpy(dst, row, size_t(f.width)); break;
+      case PixelFormat::YUYV:
+        for (int x = 0; x < f.width; ++x) dst[x] = row[2 * x];
+        break;
+      case PixelFormat::RGB24:
+        for (int x = 0; x < f.width; ++x) dst[x] = rgb_to_y(row[3 * x], row[3 * x + 1], row[3 * x + 2]);
+        break;
+    }
+  }
+}
+
+void to_rgb24(const Frame& f, std::vector<uint8_t>& out) {
+  out.resize(size_t(f.width) * f.height * 3);
+  const uint8_t* uv_plane = f.data.data() + f.bytes_per_line * size_t(f.height);
+  for (int y = 0; y < f.height; ++y) {
+    const uint8_t* row = f.data.data() + size_t(y) * f.bytes_per_line;
+    uint8_t* dst = out.data() + size_t(y) * f.width * 3;
+    switch (f.format) {
+      case PixelFormat::RGB24: std::memcpy(dst, row, size_t(f.width) * 3); break;
+      case PixelFormat::GREY:
+        for (int x = 0; x < f.width; ++x) dst[3 * x] = dst[3 * x + 1] = dst[3 * x + 2] = row[x];
+        break;
+      case PixelFormat::YUYV:
+        for (int x = 0; x < f.width; x += 2) {
+          const uint8_t* p = row + 2 * x;
+          yuv_to_rgb(p[0], p[1], p[3], dst + 3 * x);
+          yuv_to_rgb(p[2], p[1], p[3], dst + 3 * x + 3);
+        }
+        break;
+      case PixelFormat::NV12: {
+        const uint8_t* uv = uv_plane + size_t(y / 2) * f.bytes_per_line;
+        for (int x = 0; x < f.width; ++x) yuv_to_rgb(row[x], uv[x & ~1], uv[(x & ~1) + 1], dst + 3 * x);
+        break;
+      }
+    }
+  }
+}
+
+Frame from_rgb24(const uint8_t* rgb, int width, int height, PixelFormat format) {
+  Frame f = Frame::allocate(format, width, height);
+  auto px = [&](int x, int y) { return rgb + (size_t(y) * width + x) * 3; };
+  for (int y = 0; y < height; ++y) {
+    uint8_t* row = f.data.data() + size_t(y) * f.bytes_per_line;
+    switch (format) {
+      case PixelFormat::RGB24: std::memcpy(row, px(0, y), size_t(width) * 3); break;
+      case PixelFormat::GREY:
+        for (int x = 0; x < width; ++x) row[x] = rgb_to_y(px(x, y)[0], px(x, y)[1], px(x, y)[2]);
+        break;
+      case PixelFormat::YUYV:
+        for (int x = 0; x < width; x += 2) {
+          const uint8_t* a = px(x, y);
+          const uint8_t* b = px(x + 1, y);
+          const int r = (a[0] + b[0] + 1) / 2, g = (a[1] + b[1] + 1) / 2, bl = (a[2] + b[2] + 1) / 2;
+          row[2 * x] = rgb_to_y(a[0], a[1], a[2]);
+          row[2 * x + 1] = rgb_to_u(r, g, bl);
+          row[2 * x + 2] = rgb_to_y(b[0], b[1], b[2]);
+          row[2 * x + 3] = rgb_to_v(r, g, bl);
+        }
+        break;
+      case PixelFormat::NV12:
+        for (int x = 0; x < width; ++x) row[x] = rgb_to_y(px(x, y)[0], px(x, y)[1], px(x, y)[2]);
+        if (y % 2 == 0) {
+          uint8_t* uv = f.data.data() + f.bytes_per_line * size_t(height) + size_t(y / 2) * f.bytes_per_line;
+          for (int x = 0; x < width; x += 2) {
+            int r = 0, g = 0, b = 0;
+            for (int dy = 0; dy < 2; ++dy)
+              for (int dx = 0; dx < 2; ++dx) {
+                r += px(x + dx, y + dy)[0];
+                g += px(x + dx, y + dy)[1];
+                b += px(x + dx, y + dy)[2];
+              }
+            uv[x] = rgb_to_u((r + 2) / 4, (g + 2) / 4, (b + 2) / 4);
+            uv[x + 1] = rgb_to_v((r + 2) / 4, (g + 2) / 4, (b + 2) / 4);
+          }
+        }
+        break;
+    }
+  }
+  return f;
+}
+
+void rgb24_to_i420(const uint8_t* rgb, int width, int height, std::vector<uint8_t>& out) {
+  const size_t ysize = size_t(width) * height;
+  out.resize(ysize + 2 * (ysize / 4));
+  uint8_t* Y = out.data();
+  uint8_t* U = Y + ysize;
+  uint8_t* V = U + ysize / 4;
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const uint8_t* p = rgb + (size_t(y) * width + x) * 3;
+      Y[size_t(y) * width + x] = rgb_to_y(p[0], p[1], p[2]);
+    }
+  for (int y = 0; y < height; y += 2)
+    for (int x = 0; x < width; x += 2) {
+      int r = 0, g = 0, b = 0;
+      for (int dy = 0; dy < 2; ++dy)
+        for (int dx = 0; dx < 2; ++dx) {
+          const uint8_t* p = rgb + (size_t(y + dy) * width + x + dx) * 3;
+          r += p[0];
+          g += p[1];
+          b += p[2];
+        }
+      const size_t i = size_t(y / 2) * (width / 2) + x / 2;
+      U[i] = rgb_to_u((r + 2) / 4, (g + 2) / 4, (b + 2) / 4);
+      V[i] = rgb_to_v((r + 2) / 4, (g + 2) / 4, (b + 2) / 4);
+    }
+}
+
+}  // namespace arpipe

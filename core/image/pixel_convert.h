@@ -1,0 +1,21 @@
+// Conversions from any supported pixel format to the two that the pipeline works in:
+// 8-bit grey (tracking) and packed RGB24 (rendering, sinks), and RGB24 to the YUV formats (sinks).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/frame.h"
+
+namespace arpipe {
+
+// Writes width*height bytes of luma (no stride) into out.
+void to_grey(const Frame& frame, std::vector<uint8_t>& out);
+// Writes width*height*3 bytes of RGB (no stride) into out. BT.601 limited range for YUV formats.
+void to_rgb24(const Frame& frame, std::vector<uint8_t>& out);
+// Converts a packed RGB24 image (no stride) to the given format, into a new Frame (metadata left default).
+Frame from_rgb24(const uint8_t* rgb, int width, int height, PixelFormat format);
+// Planar 4:2:0 (I420, as Y4M wants it) from packed RGB24: Y plane, U plane, V plane; width and height even.
+void rgb24_to_i420(const uint8_t* rgb, int width, int height, std::vector<uint8_t>& out);
+
+}  // namespace arpipe

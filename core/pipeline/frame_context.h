@@ -1,0 +1,61 @@
+// Everything the pipeline knows about one frame, passed from stage to stage and on to the sinks.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/frame.h"
+#include "core/geometry/camera_model.h"
+#include "core/geometry/se3.h"
+
+namespace arpipe {
+
+enum class TrackState {
+  NotRun,    // tracking disabled or skipped
+  Tracking,  // pose measured on this frame
+  Lost,      // no anchor tag found on this frame
+};
+std::string_view track_state_name(TrackState state);
+
+struct TagObservation {
+  int id = 0;
+  std::array<Vec2, 4> corners{};  // pixels, AprilTag order: bottom-left, bottom-right, top-right, top-left
+  double decision_margin = 0;
+  int hamming = 0;
+};
+
+struct PoseEstimate {
+  TrackState state = TrackState::NotRun;
+  SE3 T_cam_world;              // valid when state == Tracking
+  double reprojection_rms_px = 0;
+  bool ambiguous = false;       // IPPE's two solutions were close; temporal consistency chose
+  int tags_used = 0;
+  std::vector<TagObservation> tags;  // every detection of the bundle's family on this frame
+};
+
+struct StageTiming {
+  std::string stage;
+  double ms = 0;
+  std::string skipped;  // empty when the stage ran; otherwise why it returned at once
+};
+
+struct FrameContext {
+  Frame camera;                                 // the input frame, in the source's pixel format
+  std::shared_ptr<const CameraModel> camera_model;
+  PoseEstimate pose;
+  Frame output;                                 // the composited frame, RGB24; empty until composed
+  bool virtual_layer_drawn = false;
+  std::vector<StageTiming> timings;
+  uint64_t input_index = 0;                     // position in the stream as the pipeline saw it
+  uint64_t dropped_before = 0;                  // frames lost just before this one (sequence gap or queue drop)
+
+  void record_timing(std::string stage, double ms, std::string skipped = {}) {
+    timings.push_back({std::move(stage), ms, std::move(skipped)});
+  }
+};
+
+}  // namespace arpipe

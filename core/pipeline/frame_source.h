@@ -1,0 +1,30 @@
+// Where frames come from: replay, simulator, V4L2, libcamera. Runs on the capture thread.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "core/frame.h"
+#include "core/geometry/camera_model.h"
+
+namespace arpipe {
+
+enum class SourceStatus { Frame, EndOfStream, Retry };
+
+class FrameSource {
+ public:
+  virtual ~FrameSource() = default;
+  virtual std::string describe() const = 0;
+  // Live sources drop the oldest queued frame when processing falls behind; replay blocks.
+  virtual bool is_live() const = 0;
+  // The camera model the frames were taken with (a recording carries its own).
+  virtual std::shared_ptr<const CameraModel> camera_model() const = 0;
+  // Blocks until the next frame (paced as configured). Never throws for a per-frame problem:
+  // returns Retry after logging (camera gone, timeout) or EndOfStream at the end of a recording.
+  virtual SourceStatus next(Frame& frame) = 0;
+  // Asks a blocked next() to return soon (from another thread).
+  virtual void interrupt() {}
+};
+
+}  // namespace arpipe

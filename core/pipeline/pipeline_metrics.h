@@ -1,0 +1,29 @@
+// Counters and timings the pipeline reports (sd_notify STATUS, the results sink, benchmarks).
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+
+namespace arpipe {
+
+struct StageStats {
+  uint64_t runs = 0;
+  double total_ms = 0;
+  std::map<std::string, uint64_t> skips;  // skip reason -> count
+};
+
+struct PipelineMetrics {
+  uint64_t frames_in = 0;         // frames the source delivered
+  uint64_t frames_out = 0;        // frames every sink has consumed
+  uint64_t sequence_gaps = 0;     // frames the source's sequence numbers say were lost
+  uint64_t queue_drops = 0;       // frames dropped because processing fell behind (live only)
+  uint64_t source_retries = 0;
+  uint64_t frames_tracked = 0;
+  uint64_t frames_lost = 0;
+  std::map<std::string, StageStats> stages;
+  double wall_seconds = 0;
+  double fps() const { return wall_seconds > 0 ? frames_out / wall_seconds : 0; }
+};
+
+}  // namespace arpipe

@@ -1,0 +1,71 @@
+// Runs source -> stages -> sinks on three threads joined by bounded queues (DESIGN.md "Threads").
+// The processing thread owns the stages (and so the GL context the render stages create).
+#pragma once
+
+#include <atomic>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <thread>
+#include <vector>
+
+#include "core/config/config.h"
+#include "core/pipeline/bounded_queue.h"
+#include "core/pipeline/frame_sink.h"
+#include "core/pipeline/frame_source.h"
+#include "core/pipeline/pipeline_metrics.h"
+#include "core/pipeline/stage.h"
+
+namespace arpipe {
+
+// Creates the stages on the processing thread (GL contexts are bound to the thread that made them).
+using StageFactory = std::function<std::vector<std::unique_ptr<Stage>>()>;
+
+class PipelineRunner {
+ public:
+  PipelineRunner(std::unique_ptr<FrameSource> source, StageFactory stages,
+                 std::vector<std::unique_ptr<FrameSink>> sinks, const Config& config);
+  ~PipelineRunner();  // stops and joins
+
+  // Starts the threads; blocks until the stages are configured. Throws if configuring failed.
+  void start();
+  // Ends the source, lets the queues drain through every stage and sink, flushes the sinks.
+  void stop();
+  // Blocks until the source ended and everything drained (or stop() was called).
+  void wait();
+  bool finished() const { return finished_; }
+
+  // Validated on the processing thread between frames; false (with the reason) keeps the old one.
+  bool reconfigure(const Config& config, std::string& error);
+
+  PipelineMetrics metrics() const;
+  // Time of the last frame the processing thread finished (watchdog: a stuck thread stops pinging).
+  int64_t last_progress_ns() const { return last_progress_ns_.load(); }
+
+ private:
+  void capture_loop();
+  void processing_loop();
+  void sink_loop();
+
+  std::unique_ptr<FrameSource> source_;
+  StageFactory stage_factory_;
+  std::vector<std::unique_ptr<Stage>> stages_;
+  std::vector<std::unique_ptr<FrameSink>> sinks_;
+  Config config_;
+  std::unique_ptr<BoundedQueue<FrameContext>> to_process_;
+  std::unique_ptr<BoundedQueue<FrameContext>> to_sink_;
+  std::thread capture_thread_, processing_thread_, sink_thread_;
+  std::atomic<bool> stop_requested_{false};
+  std::atomic<bool> finished_{false};
+  std::atomic<int64_t> last_progress_ns_{0};
+
+  struct PendingReconfigure;
+  std::mutex reconfigure_mutex_;
+  std::shared_ptr<PendingReconfigure> pending_reconfigure_;
+
+  mutable std::mutex metrics_mutex_;
+  PipelineMetrics metrics_;
+};
+
+}  // namespace arpipe

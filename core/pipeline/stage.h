@@ -1,0 +1,23 @@
+// A processing stage: configured once, then called per frame on the processing thread.
+// process() never throws: a problem with one frame is recorded in the FrameContext.
+#pragma once
+
+#include <string_view>
+
+#include "core/config/config.h"
+#include "core/pipeline/frame_context.h"
+
+namespace arpipe {
+
+class Stage {
+ public:
+  virtual ~Stage() = default;
+  virtual std::string_view name() const = 0;
+  // Called before the first frame and again on a config reload. May throw ConfigError (or any
+  // std::exception) to refuse the config; the stage then keeps its previous configuration.
+  virtual void configure(const Config& config) = 0;
+  // Per frame. Must not throw. Records its own timing (and skip reason) in ctx.
+  virtual void process(FrameContext& ctx) noexcept = 0;
+};
+
+}  // namespace arpipe

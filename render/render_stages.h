@@ -1,0 +1,15 @@
+// The GL stages of the pipeline: render the virtual layer (EGL, GLES 3) and composite it over the
+// camera frame into ctx.output (RGB24). Both share one GL context, created on the calling thread.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "core/pipeline/stage.h"
+
+namespace arpipe {
+
+// Returns {render, composite}. Must be called on the processing thread (it makes the context current).
+std::vector<std::unique_ptr<Stage>> make_render_stages();
+
+}  // namespace arpipe

@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# The one list of Debian 12 packages arpipe needs to build, run and test.
+# Usage: scripts/install-deps.sh   (as root, or with sudo available)
+set -euo pipefail
+
+packages=(
+  # toolchain
+  build-essential cmake pkg-config ninja-build git
+  # core
+  libmrcal-dev libdogleg-dev libapriltag-dev libopencv-dev libglm-dev
+  libtomlplusplus-dev nlohmann-json3-dev libsystemd-dev libfmt-dev
+  # render: EGL + GLES 3 on Mesa (llvmpipe when there is no GPU)
+  libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri libgbm1
+  libtinygltf-dev libstb-dev libpng-dev
+  # tests and benchmarks
+  libgtest-dev libgmock-dev librapidcheck-dev libbenchmark-dev
+  # mrcal's own tools: tests check our camera model against them
+  mrcal python3-mrcal
+  # checking the Y4M output plays
+  ffmpeg
+)
+
+sudo_cmd=()
+if [ "$(id -u)" -ne 0 ]; then sudo_cmd=(sudo); fi
+
+export DEBIAN_FRONTEND=noninteractive
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} packages already installed"
+  exit 0
+fi
+echo "install-deps: installing ${missing[*]}"
+"${sudo_cmd[@]}" apt-get update -qq
+"${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
