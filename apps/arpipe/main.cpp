@@ -1,1 +1,39 @@
-int main() { return 0; }
+// arpipe: the utility beside the daemon: inspect and replay recordings, generate captures, check configs.
+#include <cstdio>
+#include <string>
+
+#include "apps/arpipe/commands.h"
+#include "core/log.h"
+
+namespace {
+
+constexpr const char* kUsage = R"(usage: arpipe COMMAND [ARGS]
+
+commands:
+  inspect DIR                        summary of a recording: frames, format, timing, drops
+  replay DIR [--config FILE] [--set KEY=VALUE]...
+                                     run the pipeline on a recording as fast as possible
+  generate --out DIR [--frames N] [--format GREY|RGB24|YUYV|NV12] [--seed S]
+                                     write a capture of a camera moving over an AprilTag,
+                                     with exact ground truth
+  config --defaults                  print a config with every key at its default
+  config --check FILE                validate a config file
+)";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  arpipe::log::set_program_name("arpipe");
+  if (argc < 2 || std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h") {
+    std::fputs(kUsage, argc < 2 ? stderr : stdout);
+    return argc < 2 ? 2 : 0;
+  }
+  const std::string command = argv[1];
+  const arpipe::Args args(argv + 2, argv + argc);
+  if (command == "inspect") return arpipe::run_inspect(args);
+  if (command == "replay") return arpipe::run_replay(args);
+  if (command == "generate") return arpipe::run_generate(args);
+  if (command == "config") return arpipe::run_config(args);
+  std::fprintf(stderr, "arpipe: unknown command '%s'\n%s", command.c_str(), kUsage);
+  return 2;
+}

@@ -25,6 +25,8 @@ struct SourceConfig {
   bool loop = false;                    // replay: start again at the end (soak tests)
   int64_t timestamp_offset_ns = 0;      // added to every exposure_start_ns of this camera
   std::filesystem::path camera_model;   // overrides the recording's camera model when set
+
+  bool operator==(const SourceConfig&) const = default;
 };
 
 // One tag of the anchor bundle: where its centre sits in the world (anchor) frame and how it is turned.
@@ -33,6 +35,8 @@ struct BundleTag {
   double size_m = 0.1;      // edge between the black and white borders (AprilTag's "tag size")
   Vec3 center_m{0, 0, 0};   // tag centre in the world frame
   double yaw_rad = 0;       // rotation about world z of the tag's x axis; tags lie in the z=0 plane
+
+  bool operator==(const BundleTag&) const = default;
 };
 
 struct TrackConfig {
@@ -47,6 +51,8 @@ struct TrackConfig {
   // IPPE returns two poses for a planar target; when their reprojection errors are within this
   // ratio the choice is ambiguous and temporal consistency decides.
   double ambiguity_ratio = 3.0;
+
+  bool operator==(const TrackConfig&) const = default;
 };
 
 struct SceneObject {
@@ -55,6 +61,8 @@ struct SceneObject {
   double yaw_rad = 0;                  // about world z
   double scale = 1.0;
   Vec3 color{0.8, 0.3, 0.1};           // linear base colour for builtin meshes
+
+  bool operator==(const SceneObject&) const = default;
 };
 
 struct RenderConfig {
@@ -65,24 +73,34 @@ struct RenderConfig {
   Vec3 ambient{0.25, 0.25, 0.25};        // linear
   int msaa_samples = 4;
   std::string egl_platform = "auto";     // "auto", "surfaceless", "device"
+
+  bool operator==(const RenderConfig&) const = default;
 };
 
 struct PngSinkConfig {
   bool enabled = true;
   std::filesystem::path dir = "out/png";
   int every = 1;  // write every Nth frame
+
+  bool operator==(const PngSinkConfig&) const = default;
 };
 struct Y4mSinkConfig {
   bool enabled = true;
   std::filesystem::path path = "out/arpiped.y4m";
+
+  bool operator==(const Y4mSinkConfig&) const = default;
 };
 struct RecordingSinkConfig {
   bool enabled = false;
   std::filesystem::path path = "out/composited";
+
+  bool operator==(const RecordingSinkConfig&) const = default;
 };
 struct ResultsSinkConfig {
   bool enabled = true;
   std::filesystem::path path = "out/results.jsonl";  // per-frame pose, tracking state, timings
+
+  bool operator==(const ResultsSinkConfig&) const = default;
 };
 
 struct SinksConfig {
@@ -90,12 +108,16 @@ struct SinksConfig {
   Y4mSinkConfig y4m;
   RecordingSinkConfig recording;
   ResultsSinkConfig results;
+
+  bool operator==(const SinksConfig&) const = default;
 };
 
 struct PipelineConfig {
   int queue_depth = 4;
   int64_t max_frames = 0;  // 0 = no limit
   std::string log_level = "info";
+
+  bool operator==(const PipelineConfig&) const = default;
 };
 
 struct Config {
@@ -105,6 +127,8 @@ struct Config {
   RenderConfig render;
   SinksConfig sinks;
   PipelineConfig pipeline;
+
+  bool operator==(const Config&) const = default;
 };
 
 // Loads a config file. Throws ConfigError naming the file and the place on any problem:

@@ -29,9 +29,10 @@ class SE3 {
   Vec3 operator*(const Vec3& point) const;  // transforms a point
   Vec3 rotate(const Vec3& direction) const { return mat_mul(R_, direction); }
 
-  // Geodesic interpolation: this at s=0, other at s=1, constant velocity on SE(3) for s in [0,1]
-  // (extrapolates outside it). Rotation by slerp on the relative rotation, translation linearly
-  // interpolated (the "SO(3) x R3" path, which keeps the camera centre path straight).
+  // Interpolation: this at s=0, other at s=1, extrapolating outside [0,1]. The "SO(3) x R3" path:
+  // R = R_this * exp(s * log(R_this^T R_other)) (slerp, constant angular velocity) and t linearly
+  // interpolated, so the origin of `from` moves on a straight line in `to` (for T_world_cam, the
+  // camera centre moves straight at constant speed).
   SE3 interpolate(const SE3& other, double s) const;
 
   // Re-orthonormalises the rotation (polar decomposition); use after long chains of products.

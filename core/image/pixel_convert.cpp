@@ -110,7 +110,7 @@ Frame from_rgb24(const uint8_t* rgb, int width, int height, PixelFormat format) 
   return f;
 }
 
-void rgb24_to_i420(const uint8_t* rgb, int width, int height, std::vector<uint8_t>& out) {
+void rgb24_to_i420(const uint8_t* rgb, int rgb_width, int width, int height, std::vector<uint8_t>& out) {
   const size_t ysize = size_t(width) * height;
   out.resize(ysize + 2 * (ysize / 4));
   uint8_t* Y = out.data();
@@ -118,7 +118,7 @@ void rgb24_to_i420(const uint8_t* rgb, int width, int height, std::vector<uint8_
   uint8_t* V = U + ysize / 4;
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x) {
-      const uint8_t* p = rgb + (size_t(y) * width + x) * 3;
+      const uint8_t* p = rgb + (size_t(y) * rgb_width + x) * 3;
       Y[size_t(y) * width + x] = rgb_to_y(p[0], p[1], p[2]);
     }
   for (int y = 0; y < height; y += 2)
@@ -126,7 +126,7 @@ void rgb24_to_i420(const uint8_t* rgb, int width, int height, std::vector<uint8_
       int r = 0, g = 0, b = 0;
       for (int dy = 0; dy < 2; ++dy)
         for (int dx = 0; dx < 2; ++dx) {
-          const uint8_t* p = rgb + (size_t(y + dy) * width + x + dx) * 3;
+          const uint8_t* p = rgb + (size_t(y + dy) * rgb_width + x + dx) * 3;
           r += p[0];
           g += p[1];
           b += p[2];

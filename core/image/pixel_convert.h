@@ -15,7 +15,8 @@ void to_grey(const Frame& frame, std::vector<uint8_t>& out);
 void to_rgb24(const Frame& frame, std::vector<uint8_t>& out);
 // Converts a packed RGB24 image (no stride) to the given format, into a new Frame (metadata left default).
 Frame from_rgb24(const uint8_t* rgb, int width, int height, PixelFormat format);
-// Planar 4:2:0 (I420, as Y4M wants it) from packed RGB24: Y plane, U plane, V plane; width and height even.
-void rgb24_to_i420(const uint8_t* rgb, int width, int height, std::vector<uint8_t>& out);
+// Planar 4:2:0 (I420, as Y4M wants it) from packed RGB24 whose rows are rgb_width pixels long:
+// the top-left width x height pixels (both even) become a Y plane, a U plane and a V plane.
+void rgb24_to_i420(const uint8_t* rgb, int rgb_width, int width, int height, std::vector<uint8_t>& out);
 
 }  // namespace arpipe

@@ -40,8 +40,9 @@ class PipelineRunner {
   bool reconfigure(const Config& config, std::string& error);
 
   PipelineMetrics metrics() const;
-  // Time of the last frame the processing thread finished (watchdog: a stuck thread stops pinging).
-  int64_t last_progress_ns() const { return last_progress_ns_.load(); }
+  // False when the processing thread has been inside one frame for longer than max_stall_ns
+  // (the watchdog stops pinging, so systemd restarts a stuck daemon). Idle waiting is healthy.
+  bool healthy(int64_t max_stall_ns) const;
 
  private:
   void capture_loop();
@@ -58,11 +59,13 @@ class PipelineRunner {
   std::thread capture_thread_, processing_thread_, sink_thread_;
   std::atomic<bool> stop_requested_{false};
   std::atomic<bool> finished_{false};
-  std::atomic<int64_t> last_progress_ns_{0};
+  std::atomic<int64_t> busy_since_ns_{0};  // 0 while the processing thread waits for a frame
 
+  void apply_pending_reconfigure();
   struct PendingReconfigure;
   std::mutex reconfigure_mutex_;
   std::shared_ptr<PendingReconfigure> pending_reconfigure_;
+  int64_t start_ns_ = 0;
 
   mutable std::mutex metrics_mutex_;
   PipelineMetrics metrics_;

@@ -1,0 +1,17 @@
+// The subcommands of the `arpipe` utility; each takes its own arguments (after the subcommand name)
+// and returns the process exit status (0 ok, 1 failure, 2 usage or setup error).
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace arpipe {
+
+using Args = std::vector<std::string>;
+
+int run_inspect(const Args& args);   // arpipe inspect DIR
+int run_replay(const Args& args);    // arpipe replay DIR [--config FILE] [--set K=V]...
+int run_generate(const Args& args);  // arpipe generate --out DIR [--frames N] [--format F] [--seed S]
+int run_config(const Args& args);    // arpipe config --defaults | --check FILE
+
+}  // namespace arpipe

@@ -1,0 +1,59 @@
+#include "apps/common/pipeline_assembly.h"
+
+#include <fmt/format.h>
+
+#include "capture/replay_source.h"
+#include "capture/sinks/png_sink.h"
+#include "capture/sinks/recording_sink.h"
+#include "capture/sinks/results_sink.h"
+#include "capture/sinks/y4m_sink.h"
+#include "core/track/tag_tracker.h"
+#include "render/render_stages.h"
+
+namespace arpipe {
+
+std::unique_ptr<FrameSource> make_source(const Config& config) {
+  if (config.source.type == "replay") return std::make_unique<ReplaySource>(config.source);
+  throw ConfigError(fmt::format("{}: source.type \"{}\" is not supported (expected \"replay\")", config.file.string(),
+                                config.source.type));
+}
+
+std::vector<std::unique_ptr<FrameSink>> make_sinks(const Config& config) {
+  std::vector<std::unique_ptr<FrameSink>> sinks;
+  const auto& s = config.sinks;
+  if (s.results.enabled) sinks.push_back(std::make_unique<ResultsSink>(s.results));
+  if (s.png.enabled) sinks.push_back(std::make_unique<PngSink>(s.png));
+  if (s.y4m.enabled) sinks.push_back(std::make_unique<Y4mSink>(s.y4m));
+  if (s.recording.enabled) sinks.push_back(std::make_unique<RecordingSink>(s.recording));
+  return sinks;
+}
+
+StageFactory make_stage_factory() {
+  return [] {
+    std::vector<std::unique_ptr<Stage>> stages;
+    stages.push_back(std::make_unique<TagTracker>());
+    for (auto& stage : make_render_stages()) stages.push_back(std::move(stage));
+    return stages;
+  };
+}
+
+std::unique_ptr<PipelineRunner> assemble_pipeline(const Config& config) {
+  auto source = make_source(config);
+  auto sinks = make_sinks(config);
+  return std::make_unique<PipelineRunner>(std::move(source), make_stage_factory(), std::move(sinks), config);
+}
+
+std::string describe_metrics(const PipelineMetrics& m) {
+  std::string text = fmt::format(
+      "{} frames in, {} out in {:.2f} s ({:.1f} frames/s); tracked {}, lost {}; sequence gaps {}, queue drops {}, "
+      "source retries {}",
+      m.frames_in, m.frames_out, m.wall_seconds, m.fps(), m.frames_tracked, m.frames_lost, m.sequence_gaps,
+      m.queue_drops, m.source_retries);
+  for (const auto& [name, stats] : m.stages) {
+    text += fmt::format("; {} {:.2f} ms/frame", name, stats.runs ? stats.total_ms / double(stats.runs) : 0.0);
+    for (const auto& [reason, count] : stats.skips) text += fmt::format(" (skipped {}x: {})", count, reason);
+  }
+  return text;
+}
+
+}  // namespace arpipe

@@ -1,0 +1,22 @@
+// Builds a runnable pipeline (source, stages, sinks) from a Config; shared by arpiped and `arpipe replay`.
+// Setup errors throw with messages that name the file and the place; nothing here runs per frame.
+#pragma once
+
+#include <memory>
+
+#include "core/config/config.h"
+#include "core/pipeline/pipeline_runner.h"
+
+namespace arpipe {
+
+std::unique_ptr<FrameSource> make_source(const Config& config);
+std::vector<std::unique_ptr<FrameSink>> make_sinks(const Config& config);
+// track, render, composite (in that order), created on the processing thread.
+StageFactory make_stage_factory();
+// All of the above in a runner (not started).
+std::unique_ptr<PipelineRunner> assemble_pipeline(const Config& config);
+
+// Human-readable one-paragraph summary of what a finished run did, for logs and the CLI.
+std::string describe_metrics(const PipelineMetrics& metrics);
+
+}  // namespace arpipe

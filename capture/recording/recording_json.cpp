@@ -1,0 +1,237 @@
+// The JSON text of recording format v1: field names, types and units in one place (docs/FORMATS.md).
+// Every decoding error names the place and the field, and says what was expected.
+#include "capture/recording/recording_json.h"
+
+#include <fmt/format.h>
+
+#include <limits>
+#include <nlohmann/json.hpp>
+
+namespace arpipe::recording_json {
+
+namespace {
+
+using nlohmann::json;
+
+json parse_object(const std::string& text, const std::string& where, const char* what) {
+  json value;
+  try {
+    value = json::parse(text);
+  } catch (const json::parse_error& e) {
+    // e.byte counts from 1 at the character that broke the parse.
+    throw RecordingError(
+        fmt::format("{}: invalid JSON at byte {} ({} expected): {}", where, e.byte, what, e.what()));
+  }
+  if (!value.is_object()) throw RecordingError(fmt::format("{}: expected a JSON object ({})", where, what));
+  return value;
+}
+
+const json& field(const json& object, const char* name, const std::string& where, const char* expected) {
+  auto it = object.find(name);
+  if (it == object.end()) throw RecordingError(fmt::format("{}: missing field \"{}\" ({})", where, name, expected));
+  return *it;
+}
+
+[[noreturn]] void wrong_type(const char* name, const json& value, const std::string& where, const char* expected) {
+  throw RecordingError(fmt::format("{}: field \"{}\" is {}, expected {}", where, name, value.dump(), expected));
+}
+
+uint64_t get_unsigned(const json& object, const char* name, const std::string& where, const char* expected) {
+  const json& value = field(object, name, where, expected);
+  if (!value.is_number_unsigned()) wrong_type(name, value, where, expected);
+  return value.get<uint64_t>();
+}
+
+int64_t get_signed(const json& object, const char* name, const std::string& where, const char* expected) {
+  const json& value = field(object, name, where, expected);
+  if (value.is_number_unsigned()) {
+    if (value.get<uint64_t>() > uint64_t(std::numeric_limits<int64_t>::max())) wrong_type(name, value, where, expected);
+    return int64_t(value.get<uint64_t>());
+  }
+  if (!value.is_number_integer()) wrong_type(name, value, where, expected);
+  return value.get<int64_t>();
+}
+
+int get_int(const json& object, const char* name, const std::string& where, const char* expected) {
+  const int64_t value = get_signed(object, name, where, expected);
+  if (value < std::numeric_limits<int>::min() || value > std::numeric_limits<int>::max())
+    wrong_type(name, field(object, name, where, expected), where, expected);
+  return int(value);
+}
+
+double get_double(const json& object, const char* name, const std::string& where, const char* expected) {
+  const json& value = field(object, name, where, expected);
+  if (!value.is_number()) wrong_type(name, value, where, expected);
+  return value.get<double>();
+}
+
+std::string get_string(const json& object, const char* name, const std::string& where, const char* expected) {
+  const json& value = field(object, name, where, expected);
+  if (!value.is_string()) wrong_type(name, value, where, expected);
+  return value.get<std::string>();
+}
+
+// A part's name must stay inside the recording directory.
+std::string get_file_name(const json& files, const char* name, const std::string& where) {
+  const char* expected = "a plain file name inside the recording directory";
+  std::string value = get_string(files, name, where, expected);
+  if (value.empty() || value == "." || value == ".." || value.find('/') != std::string::npos ||
+      value.find('\0') != std::string::npos)
+    throw RecordingError(fmt::format("{}: files.{} is \"{}\", expected {}", where, name, value, expected));
+  return value;
+}
+
+json vec3_json(const Vec3& v) { return json::array({v[0], v[1], v[2]}); }
+
+Vec3 get_vec3(const json& object, const char* name, const std::string& where) {
+  const char* expected = "an array of 3 numbers";
+  const json& value = field(object, name, where, expected);
+  if (!value.is_array() || value.size() != 3) wrong_type(name, value, where, expected);
+  Vec3 out{};
+  for (size_t i = 0; i < 3; ++i) {
+    if (!value[i].is_number()) wrong_type(name, value, where, expected);
+    out[i] = value[i].get<double>();
+  }
+  return out;
+}
+
+json pose_json(const SE3& pose) { return json{{"r", vec3_json(pose.rotation_vector())}, {"t", vec3_json(pose.translation())}}; }
+
+SE3 get_pose(const json& object, const char* name, const std::string& where) {
+  const char* expected = "an object {\"r\": rotation vector [3], \"t\": translation in metres [3]}";
+  const json& value = field(object, name, where, expected);
+  if (!value.is_object()) wrong_type(name, value, where, expected);
+  const std::string inner = fmt::format("{} (in \"{}\")", where, name);
+  return SE3::from_rt(get_vec3(value, "r", inner), get_vec3(value, "t", inner));
+}
+
+}  // namespace
+
+std::string encode_info(const RecordingInfo& info, const FileNames& files) {
+  json j = {
+      {"format", kRecordingFormatName},
+      {"version", info.version},
+      {"pixel_format", std::string(pixel_format_name(info.pixel_format))},
+      {"width", info.width},
+      {"height", info.height},
+      {"bytes_per_line", info.bytes_per_line},
+      {"source", info.source},
+      {"created_utc", info.created_utc},
+      {"files",
+       {{"camera_model", files.camera_model},
+        {"frames", files.frames},
+        {"metadata", files.metadata},
+        {"ground_truth", files.ground_truth}}},
+  };
+  return j.dump(2) + "\n";
+}
+
+void decode_info(const std::string& text, const std::string& where, RecordingInfo& info, FileNames& files) {
+  const json j = parse_object(text, where, "the recording description");
+  const std::string format = get_string(j, "format", where, "\"arpipe-recording\"");
+  if (format != kRecordingFormatName)
+    throw RecordingError(
+        fmt::format("{}: format is \"{}\", expected \"{}\"", where, format, kRecordingFormatName));
+  // The version comes first: a newer format may change any other field.
+  info.version = get_int(j, "version", where, "an integer format version");
+  if (info.version != kRecordingFormatVersion)
+    throw RecordingError(fmt::format("{}: format version {} is not supported (this build reads version {})", where,
+                                     info.version, kRecordingFormatVersion));
+  const std::string pixel_format = get_string(j, "pixel_format", where, "GREY, RGB24, YUYV or NV12");
+  auto parsed = pixel_format_from_name(pixel_format);
+  if (!parsed)
+    throw RecordingError(fmt::format(
+        "{}: pixel_format \"{}\" is not supported (expected GREY, RGB24, YUYV or NV12)", where, pixel_format));
+  info.pixel_format = *parsed;
+  info.width = get_int(j, "width", where, "image width in pixels");
+  info.height = get_int(j, "height", where, "image height in pixels");
+  if (auto problem = check_image_size(info.pixel_format, info.width, info.height))
+    throw RecordingError(fmt::format("{}: width/height: {}", where, *problem));
+  info.bytes_per_line = get_unsigned(j, "bytes_per_line", where, "bytes per line of the first plane");
+  const size_t min_stride = min_bytes_per_line(info.pixel_format, info.width);
+  if (info.bytes_per_line < min_stride || info.bytes_per_line > 16 * min_stride)
+    throw RecordingError(fmt::format("{}: bytes_per_line {} does not fit {} pixels of {} (expected {} to {})", where,
+                                     info.bytes_per_line, info.width, pixel_format, min_stride, 16 * min_stride));
+  info.source = get_string(j, "source", where, "a string");
+  info.created_utc = get_string(j, "created_utc", where, "an ISO 8601 UTC time string");
+  const json& f = field(j, "files", where, "an object naming the parts");
+  if (!f.is_object()) wrong_type("files", f, where, "an object naming the parts");
+  files.camera_model = get_file_name(f, "camera_model", where);
+  files.frames = get_file_name(f, "frames", where);
+  files.metadata = get_file_name(f, "metadata", where);
+  files.ground_truth = get_file_name(f, "ground_truth", where);
+}
+
+std::string encode_frame_record(const FrameRecord& r) {
+  const FrameMetadata& m = r.meta;
+  // ordered_json keeps the documented field order, so a line reads well in a terminal.
+  nlohmann::ordered_json j = {
+      {"index", r.index},
+      {"offset", r.offset},
+      {"size", r.size},
+      {"crc32", r.crc32},
+      {"sequence", m.sequence},
+      {"exposure_start_ns", m.exposure_start_ns},
+      {"exposure_ns", m.exposure_ns},
+      {"readout_ns", m.readout_ns},
+      {"frame_duration_ns", m.frame_duration_ns},
+      {"analogue_gain", m.analogue_gain},
+      {"digital_gain", m.digital_gain},
+      {"raw_timestamp_ns", m.raw_timestamp_ns},
+      {"raw_timestamp_meaning", std::string(timestamp_meaning_name(m.raw_timestamp_meaning))},
+      {"timestamp_offset_ns", m.timestamp_offset_ns},
+  };
+  return j.dump();
+}
+
+FrameRecord decode_frame_record(const std::string& line, const std::string& where) {
+  const json j = parse_object(line, where, "one frame's metadata");
+  FrameRecord r;
+  r.index = get_unsigned(j, "index", where, "the frame index, counting from 0");
+  r.offset = get_unsigned(j, "offset", where, "byte offset in the frames file");
+  r.size = get_unsigned(j, "size", where, "payload size in bytes");
+  const uint64_t crc = get_unsigned(j, "crc32", where, "the payload's CRC-32 as an unsigned integer");
+  if (crc > 0xffffffffu) wrong_type("crc32", j["crc32"], where, "an unsigned 32-bit integer");
+  r.crc32 = uint32_t(crc);
+  FrameMetadata& m = r.meta;
+  m.sequence = get_unsigned(j, "sequence", where, "the source's sequence number");
+  m.exposure_start_ns = get_signed(j, "exposure_start_ns", where, "integer nanoseconds, CLOCK_MONOTONIC");
+  m.exposure_ns = get_signed(j, "exposure_ns", where, "integer nanoseconds");
+  m.readout_ns = get_signed(j, "readout_ns", where, "integer nanoseconds");
+  m.frame_duration_ns = get_signed(j, "frame_duration_ns", where, "integer nanoseconds");
+  m.analogue_gain = get_double(j, "analogue_gain", where, "a number");
+  m.digital_gain = get_double(j, "digital_gain", where, "a number");
+  m.raw_timestamp_ns = get_signed(j, "raw_timestamp_ns", where, "integer nanoseconds");
+  const char* meanings = "\"start_of_exposure\", \"end_of_frame\" or \"sensor\"";
+  const std::string meaning = get_string(j, "raw_timestamp_meaning", where, meanings);
+  if (!timestamp_meaning_from_name(meaning, m.raw_timestamp_meaning))
+    throw RecordingError(fmt::format("{}: raw_timestamp_meaning is \"{}\", expected {}", where, meaning, meanings));
+  m.timestamp_offset_ns = get_signed(j, "timestamp_offset_ns", where, "integer nanoseconds");
+  if (m.exposure_ns < 0 || m.readout_ns < 0 || m.frame_duration_ns < 0)
+    throw RecordingError(fmt::format("{}: exposure_ns, readout_ns and frame_duration_ns must not be negative", where));
+  return r;
+}
+
+std::string encode_ground_truth(const GroundTruthRecord& r) {
+  nlohmann::ordered_json j = {
+      {"index", r.index},
+      {"sequence", r.truth.sequence},
+      {"T_cam_world_start", pose_json(r.truth.T_cam_world_start)},
+      {"T_cam_world_mid", pose_json(r.truth.T_cam_world_mid)},
+      {"T_cam_world_end", pose_json(r.truth.T_cam_world_end)},
+  };
+  return j.dump();
+}
+
+GroundTruthRecord decode_ground_truth(const std::string& line, const std::string& where) {
+  const json j = parse_object(line, where, "one frame's ground truth");
+  GroundTruthRecord r;
+  r.index = get_unsigned(j, "index", where, "the frame index, counting from 0");
+  r.truth.sequence = get_unsigned(j, "sequence", where, "the frame's sequence number");
+  r.truth.T_cam_world_start = get_pose(j, "T_cam_world_start", where);
+  r.truth.T_cam_world_mid = get_pose(j, "T_cam_world_mid", where);
+  r.truth.T_cam_world_end = get_pose(j, "T_cam_world_end", where);
+  return r;
+}
+
+}  // namespace arpipe::recording_json

@@ -1,0 +1,81 @@
+#include "capture/sinks/results_sink.h"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+
+#include "capture/sinks/output_path.h"
+#include "core/log.h"
+
+namespace arpipe {
+
+ResultsSink::ResultsSink(const ResultsSinkConfig& config) : path_(config.path) {
+  create_parent_directory(path_, "sinks.results.path");
+  file_ = std::fopen(path_.c_str(), "w");
+  if (!file_) throw std::runtime_error(fmt::format("{} (config sinks.results.path): cannot open for writing: {}",
+                                                   path_.string(), std::strerror(errno)));
+}
+
+ResultsSink::~ResultsSink() {
+  flush();
+  if (file_) std::fclose(file_);
+}
+
+std::string ResultsSink::describe() const { return "results:" + path_.string(); }
+
+std::string ResultsSink::to_json_line(const FrameContext& ctx) {
+  using nlohmann::json;
+  json j;
+  j["index"] = ctx.input_index;
+  j["sequence"] = ctx.camera.meta.sequence;
+  j["exposure_start_ns"] = ctx.camera.meta.exposure_start_ns;
+  j["dropped_before"] = ctx.dropped_before;
+  j["track_state"] = std::string(track_state_name(ctx.pose.state));
+  if (ctx.pose.state == TrackState::Tracking) {
+    const Vec3 r = ctx.pose.T_cam_world.rotation_vector();
+    const Vec3& t = ctx.pose.T_cam_world.translation();
+    j["T_cam_world"] = {{"r", {r[0], r[1], r[2]}}, {"t", {t[0], t[1], t[2]}}};
+    j["reprojection_rms_px"] = ctx.pose.reprojection_rms_px;
+    j["ambiguous"] = ctx.pose.ambiguous;
+    j["tags_used"] = ctx.pose.tags_used;
+    // Where the anchor (world origin, where the virtual object stands) lands in the image.
+    if (ctx.camera_model) {
+      if (auto px = ctx.camera_model->project(ctx.pose.T_cam_world * Vec3{0, 0, 0}))
+        j["anchor_px"] = {(*px)[0], (*px)[1]};
+    }
+  }
+  j["virtual_layer_drawn"] = ctx.virtual_layer_drawn;
+  json timings = json::object();
+  json skips = json::object();
+  for (const auto& t : ctx.timings) {
+    timings[t.stage] = t.ms;
+    if (!t.skipped.empty()) skips[t.stage] = t.skipped;
+  }
+  j["stage_ms"] = timings;
+  j["skipped"] = skips;
+  return j.dump();
+}
+
+void ResultsSink::consume(const FrameContext& ctx) noexcept {
+  if (!file_) return;
+  try {
+    const std::string line = to_json_line(ctx) + "\n";
+    // One line per frame, flushed, so a crash loses at most the frame being written.
+    if (std::fwrite(line.data(), 1, line.size(), file_) != line.size() || std::fflush(file_) != 0)
+      throw std::runtime_error(std::strerror(errno));
+  } catch (const std::exception& e) {
+    if (failures_++ == 0) log::error("{}: cannot write frame {}: {}", path_.string(), ctx.input_index, e.what());
+  }
+}
+
+void ResultsSink::flush() noexcept {
+  if (!file_) return;
+  std::fflush(file_);
+  ::fsync(fileno(file_));
+}
+
+}  // namespace arpipe

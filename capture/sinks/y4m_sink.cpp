@@ -1,0 +1,71 @@
+#include "capture/sinks/y4m_sink.h"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <numeric>
+#include <stdexcept>
+
+#include "capture/sinks/output_path.h"
+#include "core/image/pixel_convert.h"
+#include "core/log.h"
+
+namespace arpipe {
+
+Y4mSink::Y4mSink(const Y4mSinkConfig& config) : path_(config.path) {
+  create_parent_directory(path_, "sinks.y4m.path");
+  file_ = std::fopen(path_.c_str(), "wb");
+  if (!file_) throw std::runtime_error(fmt::format("{} (config sinks.y4m.path): cannot open for writing: {}",
+                                                   path_.string(), std::strerror(errno)));
+}
+
+Y4mSink::~Y4mSink() {
+  flush();
+  if (file_) std::fclose(file_);
+}
+
+std::string Y4mSink::describe() const { return "y4m:" + path_.string(); }
+
+bool Y4mSink::write_header(const FrameContext& first) {
+  // 4:2:0 needs even sizes; an odd last row or column is left out rather than the frame.
+  width_ = first.output.width & ~1;
+  height_ = first.output.height & ~1;
+  // Frame rate as a ratio of integers from the camera's frame interval (30 fps when unknown).
+  int64_t num = 30, den = 1;
+  if (first.camera.meta.frame_duration_ns > 0) {
+    num = 1'000'000'000;
+    den = first.camera.meta.frame_duration_ns;
+    const int64_t g = std::gcd(num, den);
+    num /= g;
+    den /= g;
+  }
+  const std::string header = fmt::format("YUV4MPEG2 W{} H{} F{}:{} Ip A1:1 C420jpeg\n", width_, height_, num, den);
+  return std::fwrite(header.data(), 1, header.size(), file_) == header.size();
+}
+
+void Y4mSink::consume(const FrameContext& ctx) noexcept {
+  if (!file_ || ctx.output.empty()) return;
+  try {
+    if (frames_written_ == 0 && !write_header(ctx)) throw std::runtime_error("header write failed");
+    if ((ctx.output.width & ~1) != width_ || (ctx.output.height & ~1) != height_)
+      throw std::runtime_error(fmt::format("frame size {}x{} differs from the video's {}x{}", ctx.output.width,
+                                           ctx.output.height, width_, height_));
+    rgb24_to_i420(ctx.output.data.data(), ctx.output.width, width_, height_, i420_);
+    static const char kFrame[] = "FRAME\n";
+    if (std::fwrite(kFrame, 1, 6, file_) != 6 || std::fwrite(i420_.data(), 1, i420_.size(), file_) != i420_.size())
+      throw std::runtime_error(std::strerror(errno));
+    ++frames_written_;
+  } catch (const std::exception& e) {
+    if (failures_++ == 0) log::error("{}: cannot write frame {}: {}", path_.string(), ctx.input_index, e.what());
+  }
+}
+
+void Y4mSink::flush() noexcept {
+  if (!file_) return;
+  std::fflush(file_);
+  ::fsync(fileno(file_));
+}
+
+}  // namespace arpipe

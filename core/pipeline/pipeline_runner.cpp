@@ -1,0 +1,202 @@
+#include "core/pipeline/pipeline_runner.h"
+
+#include <chrono>
+#include <exception>
+#include <future>
+
+#include "core/log.h"
+#include "core/pipeline/monotonic_clock.h"
+
+namespace arpipe {
+
+struct PipelineRunner::PendingReconfigure {
+  Config config;
+  std::promise<std::string> result;  // empty string = accepted
+};
+
+PipelineRunner::PipelineRunner(std::unique_ptr<FrameSource> source, StageFactory stages,
+                               std::vector<std::unique_ptr<FrameSink>> sinks, const Config& config)
+    : source_(std::move(source)), stage_factory_(std::move(stages)), sinks_(std::move(sinks)), config_(config) {}
+
+PipelineRunner::~PipelineRunner() {
+  stop();
+  wait();
+}
+
+void PipelineRunner::start() {
+  const size_t depth = size_t(config_.pipeline.queue_depth);
+  // Replay must be deterministic frame for frame, so it blocks; a live camera must not fall behind.
+  to_process_ = std::make_unique<BoundedQueue<FrameContext>>(
+      depth, source_->is_live() ? OverflowPolicy::DropOldest : OverflowPolicy::Block);
+  to_sink_ = std::make_unique<BoundedQueue<FrameContext>>(depth, OverflowPolicy::Block);
+  start_ns_ = monotonic_now_ns();
+
+  // The stages are created and configured on the processing thread, which owns their GL context.
+  std::promise<void> configured;
+  auto configured_future = configured.get_future();
+  processing_thread_ = std::thread([this, &configured] {
+    try {
+      stages_ = stage_factory_();
+      for (auto& stage : stages_) stage->configure(config_);
+    } catch (...) {
+      stages_.clear();
+      configured.set_exception(std::current_exception());
+      return;
+    }
+    configured.set_value();
+    processing_loop();
+  });
+  try {
+    configured_future.get();
+  } catch (...) {
+    processing_thread_.join();
+    throw;
+  }
+  sink_thread_ = std::thread([this] { sink_loop(); });
+  capture_thread_ = std::thread([this] { capture_loop(); });
+}
+
+void PipelineRunner::stop() {
+  stop_requested_ = true;
+  if (source_) source_->interrupt();
+}
+
+void PipelineRunner::wait() {
+  if (capture_thread_.joinable()) capture_thread_.join();
+  if (processing_thread_.joinable()) processing_thread_.join();
+  if (sink_thread_.joinable()) sink_thread_.join();
+}
+
+void PipelineRunner::capture_loop() {
+  std::optional<uint64_t> previous_sequence;
+  uint64_t index = 0;
+  const int64_t max_frames = config_.pipeline.max_frames;
+  while (!stop_requested_) {
+    if (max_frames > 0 && int64_t(index) >= max_frames) break;
+    FrameContext ctx;
+    SourceStatus status = SourceStatus::EndOfStream;
+    try {
+      status = source_->next(ctx.camera);
+    } catch (const std::exception& e) {  // sources must not throw; survive one that does
+      log::error("source {}: {}", source_->describe(), e.what());
+      status = SourceStatus::Retry;
+    }
+    if (status == SourceStatus::EndOfStream) break;
+    if (status == SourceStatus::Retry) {
+      std::lock_guard lock(metrics_mutex_);
+      ++metrics_.source_retries;
+      continue;
+    }
+    const uint64_t sequence = ctx.camera.meta.sequence;
+    if (previous_sequence && sequence > *previous_sequence + 1) ctx.dropped_before = sequence - *previous_sequence - 1;
+    previous_sequence = sequence;
+    ctx.camera_model = source_->camera_model();
+    ctx.input_index = index++;
+    {
+      std::lock_guard lock(metrics_mutex_);
+      ++metrics_.frames_in;
+      metrics_.sequence_gaps += ctx.dropped_before;
+    }
+    if (!to_process_->push(std::move(ctx))) break;
+  }
+  to_process_->close();
+}
+
+void PipelineRunner::processing_loop() {
+  while (auto ctx = to_process_->pop()) {
+    busy_since_ns_ = monotonic_now_ns();
+    apply_pending_reconfigure();
+    for (auto& stage : stages_) stage->process(*ctx);
+    {
+      std::lock_guard lock(metrics_mutex_);
+      for (const auto& t : ctx->timings) {
+        auto& stats = metrics_.stages[t.stage];
+        ++stats.runs;
+        stats.total_ms += t.ms;
+        if (!t.skipped.empty()) ++stats.skips[t.skipped];
+      }
+      if (ctx->pose.state == TrackState::Tracking) ++metrics_.frames_tracked;
+      if (ctx->pose.state == TrackState::Lost) ++metrics_.frames_lost;
+    }
+    busy_since_ns_ = 0;
+    to_sink_->push(std::move(*ctx));
+  }
+  to_sink_->close();
+  apply_pending_reconfigure();  // answer a reload that raced with the end of the stream
+  stages_.clear();              // destroys the GL context on the thread that made it
+}
+
+void PipelineRunner::sink_loop() {
+  while (auto ctx = to_sink_->pop()) {
+    for (auto& sink : sinks_) sink->consume(*ctx);
+    std::lock_guard lock(metrics_mutex_);
+    ++metrics_.frames_out;
+    metrics_.wall_seconds = double(monotonic_now_ns() - start_ns_) * 1e-9;
+  }
+  for (auto& sink : sinks_) sink->flush();
+  finished_ = true;
+}
+
+bool PipelineRunner::reconfigure(const Config& config, std::string& error) {
+  auto request = std::make_shared<PendingReconfigure>();
+  request->config = config;
+  auto answer = request->result.get_future();
+  {
+    std::lock_guard lock(reconfigure_mutex_);
+    pending_reconfigure_ = request;
+  }
+  // The processing thread picks it up before its next frame.
+  if (answer.wait_for(std::chrono::seconds(10)) != std::future_status::ready) {
+    std::lock_guard lock(reconfigure_mutex_);
+    if (pending_reconfigure_ == request) pending_reconfigure_.reset();
+    error = "the pipeline did not reach a frame boundary within 10 s (no frames arriving?)";
+    return false;
+  }
+  error = answer.get();
+  return error.empty();
+}
+
+void PipelineRunner::apply_pending_reconfigure() {
+  std::shared_ptr<PendingReconfigure> request;
+  {
+    std::lock_guard lock(reconfigure_mutex_);
+    request.swap(pending_reconfigure_);
+  }
+  if (!request) return;
+  std::string error;
+  for (auto& stage : stages_) {
+    try {
+      stage->configure(request->config);
+    } catch (const std::exception& e) {
+      error = fmt::format("stage {}: {}", stage->name(), e.what());
+      break;
+    }
+  }
+  if (!error.empty()) {
+    // Put every stage back on the configuration that was running.
+    for (auto& stage : stages_) {
+      try {
+        stage->configure(config_);
+      } catch (const std::exception& e) {
+        log::error("stage {} could not return to the running config: {}", stage->name(), e.what());
+      }
+    }
+  } else {
+    config_ = request->config;
+  }
+  request->result.set_value(error);
+}
+
+PipelineMetrics PipelineRunner::metrics() const {
+  std::lock_guard lock(metrics_mutex_);
+  PipelineMetrics m = metrics_;
+  if (to_process_) m.queue_drops = to_process_->dropped();
+  return m;
+}
+
+bool PipelineRunner::healthy(int64_t max_stall_ns) const {
+  const int64_t since = busy_since_ns_.load();
+  return since == 0 || monotonic_now_ns() - since < max_stall_ns;
+}
+
+}  // namespace arpipe

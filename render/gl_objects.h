@@ -1,0 +1,49 @@
+// Move-only owners of GL object names (textures, buffers, framebuffers...), so that GL resources
+// follow C++ lifetimes. They must be destroyed while their context is current.
+#pragma once
+
+#include <GLES3/gl3.h>
+
+#include <utility>
+
+namespace arpipe {
+
+template <void (*Generate)(GLsizei, GLuint*), void (*Delete)(GLsizei, const GLuint*)>
+class GlObject {
+ public:
+  GlObject() = default;
+  static GlObject create() {
+    GlObject object;
+    Generate(1, &object.name_);
+    return object;
+  }
+  ~GlObject() { reset(); }
+  GlObject(GlObject&& other) noexcept : name_(std::exchange(other.name_, 0)) {}
+  GlObject& operator=(GlObject&& other) noexcept {
+    if (this != &other) {
+      reset();
+      name_ = std::exchange(other.name_, 0);
+    }
+    return *this;
+  }
+  GlObject(const GlObject&) = delete;
+  GlObject& operator=(const GlObject&) = delete;
+
+  GLuint get() const { return name_; }
+  explicit operator bool() const { return name_ != 0; }
+  void reset() {
+    if (name_ != 0) Delete(1, &name_);
+    name_ = 0;
+  }
+
+ private:
+  GLuint name_ = 0;
+};
+
+using GlTexture = GlObject<glGenTextures, glDeleteTextures>;
+using GlBuffer = GlObject<glGenBuffers, glDeleteBuffers>;
+using GlFramebuffer = GlObject<glGenFramebuffers, glDeleteFramebuffers>;
+using GlRenderbuffer = GlObject<glGenRenderbuffers, glDeleteRenderbuffers>;
+using GlVertexArray = GlObject<glGenVertexArrays, glDeleteVertexArrays>;
+
+}  // namespace arpipe

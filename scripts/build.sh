@@ -1,0 +1,13 @@
+#!/usr/bin/env bash
+# Configures and builds arpipe into a build directory (default: build/). Extra args go to cmake.
+# Usage: scripts/build.sh [BUILD_DIR] [-DOPTION=VALUE]...
+set -euo pipefail
+cd "$(dirname "$0")/.."
+build_dir=${1:-build}
+shift || true
+werror=OFF
+if [ "${CI:-}" = "true" ]; then werror=ON; fi
+generator=()
+if command -v ninja >/dev/null 2>&1; then generator=(-G Ninja); fi
+cmake -S . -B "$build_dir" "${generator[@]}" -DARPIPE_WERROR=$werror "$@"
+cmake --build "$build_dir" -j "$(nproc)"

@@ -1,0 +1,93 @@
+// Runs a program of the build (arpiped, arpipe) as a real child process for end-to-end tests,
+// with stdout and stderr captured to files, and lets the test signal it and wait for it.
+#pragma once
+
+#include <signal.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace arpipe::test {
+
+inline std::filesystem::path build_program(const std::string& name) {
+  return std::filesystem::path(ARPIPE_BINARY_DIR) / "apps" / name;
+}
+
+inline std::string read_text(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+class ChildProcess {
+ public:
+  ChildProcess(const std::filesystem::path& program, const std::vector<std::string>& args,
+               const std::filesystem::path& log_dir)
+      : stdout_path_(log_dir / "stdout.txt"), stderr_path_(log_dir / "stderr.txt") {
+    std::filesystem::create_directories(log_dir);
+    pid_ = fork();
+    if (pid_ == 0) {
+      if (!freopen(stdout_path_.c_str(), "w", stdout) || !freopen(stderr_path_.c_str(), "w", stderr)) _exit(127);
+      std::vector<char*> argv;
+      std::string prog = program.string();
+      argv.push_back(prog.data());
+      std::vector<std::string> copy = args;
+      for (auto& a : copy) argv.push_back(a.data());
+      argv.push_back(nullptr);
+      execv(prog.c_str(), argv.data());
+      _exit(127);
+    }
+  }
+  ~ChildProcess() {
+    if (pid_ > 0 && !exited_) {
+      kill(pid_, SIGKILL);
+      waitpid(pid_, nullptr, 0);
+    }
+  }
+
+  void signal(int sig) { kill(pid_, sig); }
+
+  // Waits up to timeout; returns the wait status (or -1 on timeout, after killing the child).
+  int wait(std::chrono::seconds timeout = std::chrono::seconds(120)) {
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    while (std::chrono::steady_clock::now() < deadline) {
+      int status = 0;
+      if (waitpid(pid_, &status, WNOHANG) == pid_) {
+        exited_ = true;
+        return status;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    return -1;
+  }
+
+  std::string stderr_text() const { return read_text(stderr_path_); }
+  std::string stdout_text() const { return read_text(stdout_path_); }
+
+ private:
+  std::filesystem::path stdout_path_, stderr_path_;
+  pid_t pid_ = -1;
+  bool exited_ = false;
+};
+
+// Runs to completion; returns the exit code, or -(signal) if it died of a signal, or -1000 on timeout.
+inline int run_to_exit(const std::filesystem::path& program, const std::vector<std::string>& args,
+                       const std::filesystem::path& log_dir, std::string* stderr_text = nullptr) {
+  ChildProcess child(program, args, log_dir);
+  const int status = child.wait();
+  if (stderr_text) *stderr_text = child.stderr_text();
+  if (status == -1) return -1000;
+  if (WIFSIGNALED(status)) return -WTERMSIG(status);
+  return WEXITSTATUS(status);
+}
+
+}  // namespace arpipe::test
