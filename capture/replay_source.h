@@ -2,6 +2,7 @@
 // possible, optionally looping. Never drops frames (the pipeline blocks instead).
 #pragma once
 
+#include <cstdint>
 #include <memory>
 
 #include "core/config/config.h"
@@ -11,16 +12,24 @@ namespace arpipe {
 
 class ReplaySource : public FrameSource {
  public:
-  // Opens the recording named by config.path; throws RecordingError / CameraModelError on bad input
-  // (including a camera_model override whose image size differs from the recording's).
+  // Opens the recording named by config.path; throws RecordingError (bad recording), CameraModelError
+  // (bad camera_model override, or one whose image size differs from the recording's) or ConfigError
+  // (unknown pacing).
   explicit ReplaySource(const SourceConfig& config);
   ~ReplaySource() override;
 
   std::string describe() const override;
   bool is_live() const override { return false; }
   std::shared_ptr<const CameraModel> camera_model() const override;
+  // Frames come with timestamp_offset_ns added to exposure_start_ns. Looping adds the recording's
+  // duration plus one frame interval per pass to the timestamps (and its frame count to the
+  // sequence numbers), so time and sequence never go backwards. A frame that fails its checksum
+  // is logged, counted and skipped (Retry); an interrupt() during a pacing sleep returns Retry
+  // and the frame comes with the next call.
   SourceStatus next(Frame& frame) override;
   void interrupt() override;
+
+  uint64_t frames_skipped() const;  // damaged frames left out so far
 
  private:
   struct Impl;

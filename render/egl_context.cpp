@@ -119,6 +119,16 @@ std::vector<EglDevice> enumerate_devices() {
   return devices;
 }
 
+// Through eglGetProcAddress rather than a direct call, so a libEGL that predates EGL 1.5 still
+// links; both platforms require EGL_EXT_platform_base or EGL 1.5 anyway.
+EGLDisplay get_platform_display(EGLenum platform, void* native_display) {
+  if (auto get_ext = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT")))
+    return get_ext(platform, native_display, nullptr);
+  if (auto get_core = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYPROC>(eglGetProcAddress("eglGetPlatformDisplay")))
+    return get_core(platform, native_display, nullptr);
+  return EGL_NO_DISPLAY;
+}
+
 // Hardware first: the software device renders exactly as the surfaceless platform does.
 std::optional<EglDevice> preferred_device() {
   std::vector<EglDevice> devices = enumerate_devices();
@@ -195,7 +205,7 @@ EglContext::EglContext(std::string_view requested) : egl_(std::make_unique<Handl
 
   if (requested != "surfaceless") {
     if (std::optional<EglDevice> device = preferred_device()) {
-      EGLDisplay display = eglGetPlatformDisplay(EGL_PLATFORM_DEVICE_EXT, device->handle, nullptr);
+      EGLDisplay display = get_platform_display(EGL_PLATFORM_DEVICE_EXT, device->handle);
       if (auto why = create_on_display(display, egl_->display, egl_->context)) {
         failures.push_back(fmt::format("device platform ({}): {}", device->description, *why));
       } else {
@@ -210,7 +220,7 @@ EglContext::EglContext(std::string_view requested) : egl_(std::make_unique<Handl
   }
   if (egl_->context == EGL_NO_CONTEXT && requested != "device") {
     if (has_word(extensions, "EGL_MESA_platform_surfaceless")) {
-      EGLDisplay display = eglGetPlatformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
+      EGLDisplay display = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY);
       if (auto why = create_on_display(display, egl_->display, egl_->context))
         failures.push_back(fmt::format("surfaceless platform: {}", *why));
       else

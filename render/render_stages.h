@@ -9,7 +9,8 @@
 
 namespace arpipe {
 
-// Returns {render, composite}. Must be called on the processing thread (it makes the context current).
+// Returns {render, composite}. The render stage's first configure() creates the GL context on the
+// calling thread, so configure and process both stages on the processing thread, in this order.
 std::vector<std::unique_ptr<Stage>> make_render_stages();
 
 }  // namespace arpipe

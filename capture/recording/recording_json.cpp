@@ -13,14 +13,15 @@ namespace {
 
 using nlohmann::json;
 
-json parse_object(const std::string& text, const std::string& where, const char* what) {
+// in_line: the text is one line of a .jsonl file, so the byte position counts within the line.
+json parse_object(const std::string& text, const std::string& where, const char* what, bool in_line) {
   json value;
   try {
     value = json::parse(text);
   } catch (const json::parse_error& e) {
     // e.byte counts from 1 at the character that broke the parse.
-    throw RecordingError(
-        fmt::format("{}: invalid JSON at byte {} ({} expected): {}", where, e.byte, what, e.what()));
+    throw RecordingError(fmt::format("{}: invalid JSON at byte {}{} ({} expected): {}", where, e.byte,
+                                     in_line ? " of the line" : "", what, e.what()));
   }
   if (!value.is_object()) throw RecordingError(fmt::format("{}: expected a JSON object ({})", where, what));
   return value;
@@ -95,7 +96,9 @@ Vec3 get_vec3(const json& object, const char* name, const std::string& where) {
   return out;
 }
 
-json pose_json(const SE3& pose) { return json{{"r", vec3_json(pose.rotation_vector())}, {"t", vec3_json(pose.translation())}}; }
+json pose_json(const SE3& pose) {
+  return json{{"r", vec3_json(pose.rotation_vector())}, {"t", vec3_json(pose.translation())}};
+}
 
 SE3 get_pose(const json& object, const char* name, const std::string& where) {
   const char* expected = "an object {\"r\": rotation vector [3], \"t\": translation in metres [3]}";
@@ -108,7 +111,7 @@ SE3 get_pose(const json& object, const char* name, const std::string& where) {
 }  // namespace
 
 std::string encode_info(const RecordingInfo& info, const FileNames& files) {
-  json j = {
+  nlohmann::ordered_json j = {
       {"format", kRecordingFormatName},
       {"version", info.version},
       {"pixel_format", std::string(pixel_format_name(info.pixel_format))},
@@ -127,11 +130,10 @@ std::string encode_info(const RecordingInfo& info, const FileNames& files) {
 }
 
 void decode_info(const std::string& text, const std::string& where, RecordingInfo& info, FileNames& files) {
-  const json j = parse_object(text, where, "the recording description");
+  const json j = parse_object(text, where, "the recording description", false);
   const std::string format = get_string(j, "format", where, "\"arpipe-recording\"");
   if (format != kRecordingFormatName)
-    throw RecordingError(
-        fmt::format("{}: format is \"{}\", expected \"{}\"", where, format, kRecordingFormatName));
+    throw RecordingError(fmt::format("{}: format is \"{}\", expected \"{}\"", where, format, kRecordingFormatName));
   // The version comes first: a newer format may change any other field.
   info.version = get_int(j, "version", where, "an integer format version");
   if (info.version != kRecordingFormatVersion)
@@ -140,8 +142,8 @@ void decode_info(const std::string& text, const std::string& where, RecordingInf
   const std::string pixel_format = get_string(j, "pixel_format", where, "GREY, RGB24, YUYV or NV12");
   auto parsed = pixel_format_from_name(pixel_format);
   if (!parsed)
-    throw RecordingError(fmt::format(
-        "{}: pixel_format \"{}\" is not supported (expected GREY, RGB24, YUYV or NV12)", where, pixel_format));
+    throw RecordingError(fmt::format("{}: pixel_format \"{}\" is not supported (expected GREY, RGB24, YUYV or NV12)",
+                                     where, pixel_format));
   info.pixel_format = *parsed;
   info.width = get_int(j, "width", where, "image width in pixels");
   info.height = get_int(j, "height", where, "image height in pixels");
@@ -185,7 +187,7 @@ std::string encode_frame_record(const FrameRecord& r) {
 }
 
 FrameRecord decode_frame_record(const std::string& line, const std::string& where) {
-  const json j = parse_object(line, where, "one frame's metadata");
+  const json j = parse_object(line, where, "one frame's metadata", true);
   FrameRecord r;
   r.index = get_unsigned(j, "index", where, "the frame index, counting from 0");
   r.offset = get_unsigned(j, "offset", where, "byte offset in the frames file");
@@ -224,7 +226,7 @@ std::string encode_ground_truth(const GroundTruthRecord& r) {
 }
 
 GroundTruthRecord decode_ground_truth(const std::string& line, const std::string& where) {
-  const json j = parse_object(line, where, "one frame's ground truth");
+  const json j = parse_object(line, where, "one frame's ground truth", true);
   GroundTruthRecord r;
   r.index = get_unsigned(j, "index", where, "the frame index, counting from 0");
   r.truth.sequence = get_unsigned(j, "sequence", where, "the frame's sequence number");

@@ -44,11 +44,11 @@ std::vector<Record> parse_jsonl(const std::string& text, const fs::path& path, D
       const std::string line = text.substr(begin);
       try {
         records.push_back(decode(line, where));
-        warnings.push_back(fmt::format("{}: no final newline (an interrupted append); the line is complete, kept",
-                                       where));
+        warnings.push_back(
+            fmt::format("{}: no final newline (an interrupted append); the line is complete, kept", where));
       } catch (const RecordingError&) {
-        warnings.push_back(fmt::format("{}: cut off after {} bytes (an interrupted append); ignored", where,
-                                       line.size()));
+        warnings.push_back(
+            fmt::format("{}: cut off after {} bytes (an interrupted append); ignored", where, line.size()));
       }
       break;
     }
@@ -105,44 +105,47 @@ struct RecordingReader::Impl {
     } catch (const std::exception& e) {
       throw RecordingError(e.what());
     }
-    records = parse_jsonl<recording_json::FrameRecord>(text, metadata_path, recording_json::decode_frame_record,
-                                                       warnings);
+    records =
+        parse_jsonl<recording_json::FrameRecord>(text, metadata_path, recording_json::decode_frame_record, warnings);
     uint64_t expected_offset = 0;
     for (size_t i = 0; i < records.size(); ++i) {
       const auto& r = records[i];
       const std::string where = fmt::format("{} line {}", metadata_path.string(), i + 1);
       if (r.index != i)
-        throw RecordingError(fmt::format("{}: index {}, expected {} (lines count the frames from 0)", where, r.index, i));
+        throw RecordingError(
+            fmt::format("{}: index {}, expected {} (lines count the frames from 0)", where, r.index, i));
       if (r.size != frame_bytes)
         throw RecordingError(fmt::format("{}: size {}, expected {} (one {}x{} {} image with {} bytes per line)", where,
                                          r.size, frame_bytes, info.width, info.height,
                                          pixel_format_name(info.pixel_format), info.bytes_per_line));
       if (r.offset != expected_offset)
-        throw RecordingError(fmt::format("{}: offset {}, expected {} (payloads lie back to back)", where, r.offset,
-                                         expected_offset));
+        throw RecordingError(
+            fmt::format("{}: offset {}, expected {} (payloads lie back to back)", where, r.offset, expected_offset));
       expected_offset += r.size;
     }
     const uint64_t frames_size = frames.size();
-    auto first_missing = std::find_if(records.begin(), records.end(),
-                                      [&](const auto& r) { return r.offset + r.size > frames_size; });
+    auto first_missing =
+        std::find_if(records.begin(), records.end(), [&](const auto& r) { return r.offset + r.size > frames_size; });
     if (first_missing != records.end()) {
-      warnings.push_back(fmt::format("{}: ends at byte {} inside frame {} (bytes {} to {}): an interrupted append; "
-                                     "{} frame(s) dropped",
-                                     frames_path.string(), frames_size, first_missing->index, first_missing->offset,
-                                     first_missing->offset + first_missing->size, records.end() - first_missing));
+      warnings.push_back(
+          fmt::format("{}: ends at byte {} inside frame {} (bytes {} to {}): an interrupted append; "
+                      "{} frame(s) dropped",
+                      frames_path.string(), frames_size, first_missing->index, first_missing->offset,
+                      first_missing->offset + first_missing->size, records.end() - first_missing));
       records.erase(first_missing, records.end());
     } else if (frames_size > expected_offset) {
-      warnings.push_back(fmt::format("{}: {} bytes after the last complete frame (from byte {}): an interrupted "
-                                     "append; ignored",
-                                     frames_path.string(), frames_size - expected_offset, expected_offset));
+      warnings.push_back(
+          fmt::format("{}: {} bytes after the last complete frame (from byte {}): an interrupted "
+                      "append; ignored",
+                      frames_path.string(), frames_size - expected_offset, expected_offset));
     }
   }
 
   void load_ground_truth() {
     const fs::path path = dir / files.ground_truth;
     if (!fs::exists(path)) return;
-    const auto truths = parse_jsonl<recording_json::GroundTruthRecord>(
-        read_text(path, "ground truth"), path, recording_json::decode_ground_truth, warnings);
+    const auto truths = parse_jsonl<recording_json::GroundTruthRecord>(read_text(path, "ground truth"), path,
+                                                                       recording_json::decode_ground_truth, warnings);
     for (size_t i = 0; i < truths.size(); ++i) {
       const std::string where = fmt::format("{} line {}", path.string(), i + 1);
       if (truths[i].index != i)
@@ -153,9 +156,10 @@ struct RecordingReader::Impl {
                                          (dir / files.metadata).string()));
     }
     if (truths.size() < records.size()) {
-      warnings.push_back(fmt::format("{}: ends after frame {} of {}: an interrupted append; the frames without "
-                                     "ground truth are dropped",
-                                     path.string(), truths.size(), records.size()));
+      warnings.push_back(
+          fmt::format("{}: ends after frame {} of {}: an interrupted append; the frames without "
+                      "ground truth are dropped",
+                      path.string(), truths.size(), records.size()));
       records.resize(truths.size());
     } else if (truths.size() > records.size()) {
       // Ground truth is written before the metadata line that commits its frame.
@@ -194,9 +198,9 @@ void RecordingReader::read(size_t index, Frame& frame) const {
   const Impl& r = *impl_;
   const auto& record = r.records.at(index);
   const fs::path frames_path = r.dir / r.files.frames;
-  const std::string place = fmt::format("{}: frame {} (bytes {} to {}, {} line {})", frames_path.string(), index,
-                                        record.offset, record.offset + record.size,
-                                        (r.dir / r.files.metadata).string(), index + 1);
+  const std::string place =
+      fmt::format("{}: frame {} (bytes {} to {}, {} line {})", frames_path.string(), index, record.offset,
+                  record.offset + record.size, (r.dir / r.files.metadata).string(), index + 1);
   frame.meta = record.meta;
   frame.format = r.info.pixel_format;
   frame.width = r.info.width;
@@ -211,8 +215,8 @@ void RecordingReader::read(size_t index, Frame& frame) const {
   }
   const auto crc = uint32_t(crc32_z(crc32_z(0, nullptr, 0), frame.data.data(), frame.data.size()));
   if (crc != record.crc32)
-    throw RecordingError(fmt::format("{}: CRC-32 {:08x} does not match the recorded {:08x} (damaged pixels)", place,
-                                     crc, record.crc32));
+    throw RecordingError(
+        fmt::format("{}: CRC-32 {:08x} does not match the recorded {:08x} (damaged pixels)", place, crc, record.crc32));
 }
 
 }  // namespace arpipe

@@ -98,9 +98,10 @@ RecordingWriter::RecordingWriter(const fs::path& dir, const RecordingInfo& info,
     if (fs::exists(dir / kRecordingInfoFile))
       throw RecordingError(fmt::format("{}: already holds a recording ({} exists); refusing to overwrite it",
                                        dir.string(), kRecordingInfoFile));
+    for (const std::string& part : {w.files.camera_model, w.files.frames, w.files.metadata, w.files.ground_truth})
+      if (fs::exists(dir / part))
+        throw RecordingError(fmt::format("{}: exists already; refusing to overwrite it", (dir / part).string()));
     const fs::path model_path = dir / w.files.camera_model;
-    if (fs::exists(model_path))
-      throw RecordingError(fmt::format("{}: exists already; refusing to overwrite it", model_path.string()));
     model.save(model_path);
     w.frames = PosixFile(dir / w.files.frames, PosixFile::Mode::CreateNew);
     w.metadata = PosixFile(dir / w.files.metadata, PosixFile::Mode::CreateNew);
@@ -126,16 +127,17 @@ void RecordingWriter::append(const Frame& frame, const std::optional<GroundTruth
   const uint64_t index = w.frames_written;
   if (frame.format != info.pixel_format || frame.width != info.width || frame.height != info.height ||
       frame.bytes_per_line != info.bytes_per_line || frame.data.size() != w.frame_bytes)
-    throw RecordingError(fmt::format(
-        "{}: frame {} is {}x{} {} with {} bytes per line and {} bytes, expected {}x{} {} with {} and {}",
-        w.dir.string(), index, frame.width, frame.height, pixel_format_name(frame.format), frame.bytes_per_line,
-        frame.data.size(), info.width, info.height, pixel_format_name(info.pixel_format), info.bytes_per_line,
-        w.frame_bytes));
+    throw RecordingError(
+        fmt::format("{}: frame {} is {}x{} {} with {} bytes per line and {} bytes, expected {}x{} {} with {} and {}",
+                    w.dir.string(), index, frame.width, frame.height, pixel_format_name(frame.format),
+                    frame.bytes_per_line, frame.data.size(), info.width, info.height,
+                    pixel_format_name(info.pixel_format), info.bytes_per_line, w.frame_bytes));
   if (index == 0) w.has_ground_truth = truth.has_value();
   if (truth.has_value() != w.has_ground_truth)
-    throw RecordingError(fmt::format("{}: frame {} {} ground truth, but the first frame {}: give it for every frame "
-                                     "or for none",
-                                     w.dir.string(), index, truth ? "has" : "has no", truth ? "had none" : "had it"));
+    throw RecordingError(
+        fmt::format("{}: frame {} {} ground truth, but the first frame {}: give it for every frame "
+                    "or for none",
+                    w.dir.string(), index, truth ? "has" : "has no", truth ? "had none" : "had it"));
 
   recording_json::FrameRecord record;
   record.index = index;

@@ -26,6 +26,8 @@ class Y4mSink : public FrameSink {
   int width_ = 0, height_ = 0;
   uint64_t frames_written_ = 0;
   uint64_t failures_ = 0;
+  bool write_failed_ = false;
+  std::vector<uint8_t> packed_;  // the frame without row padding, when it has some
   std::vector<uint8_t> i420_;
 };
 

@@ -68,7 +68,7 @@ struct SceneObject {
 struct RenderConfig {
   bool enabled = true;
   std::vector<SceneObject> objects{SceneObject{}};
-  Vec3 light_direction{0.3, -0.4, 1.0};  // world frame, pointing towards the light (normalised at load)
+  Vec3 light_direction = normalized(Vec3{0.3, -0.4, 1.0});  // world frame, towards the light; unit length
   Vec3 light_color{1.0, 1.0, 1.0};       // linear
   Vec3 ambient{0.25, 0.25, 0.25};        // linear
   int msaa_samples = 4;
@@ -133,8 +133,9 @@ struct Config {
 
 // Loads a config file. Throws ConfigError naming the file and the place on any problem:
 // unreadable file, TOML syntax, unknown key, wrong type, value out of range.
-// overrides: "section.key=value" assignments (value in TOML syntax) from the command line,
-// applied before validation, so they are checked like the file.
+// overrides: "section.key=value" assignments (value in TOML syntax; a bare word such as fast or
+// out/run1 is taken as a string) from the command line, applied before validation, so they are
+// checked like the file. Elements of arrays of tables are addressed by index: render.objects.0.scale=2.
 Config load_config(const std::filesystem::path& path, const std::vector<std::string>& overrides = {});
 // Parses TOML text; source_name is used in messages.
 Config parse_config(const std::string& text, const std::string& source_name,

@@ -8,6 +8,7 @@ extern "C" {
 
 #include <fmt/format.h>
 
+#include <cctype>
 #include <cerrno>
 #include <climits>
 #include <cmath>
@@ -102,7 +103,15 @@ class DictLiteralScanner {
       token.text = text_.substr(start, pos_ - start);
       return token;
     }
-    throw error(token.at, fmt::format("unexpected character '{}'", c));
+    throw error(token.at, fmt::format("expected a Python literal, got {}", describe_char(c)));
+  }
+
+  // Skips blanks and comments; throws unless the next character opens the top-level dict.
+  void expect_dict_start() {
+    skip_space_and_comments();
+    if (pos_ < text_.size() && text_[pos_] == '{') return;
+    throw error(here(), fmt::format("expected '{{' (a .cameramodel is a Python dict literal), got {}",
+                                    pos_ < text_.size() ? describe_char(text_[pos_]) : "the end of the file"));
   }
 
   CameraModelError error(Place at, const std::string& what) const {
@@ -111,6 +120,11 @@ class DictLiteralScanner {
 
  private:
   Place here() const { return {line_, static_cast<int>(pos_ - line_start_) + 1}; }
+  static std::string describe_char(char c) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (std::isprint(byte)) return fmt::format("'{}'", c);
+    return fmt::format("the byte 0x{:02x}", byte);
+  }
   void advance() {
     if (text_[pos_] == '\n') {
       ++line_;
@@ -189,10 +203,8 @@ class DictLiteralParser {
   // The top-level keys in file order with their values.
   std::vector<std::pair<std::string, LiteralValue>> parse_top_level() {
     std::vector<std::pair<std::string, LiteralValue>> entries;
+    scanner_.expect_dict_start();
     Token token = scanner_.next();
-    if (token.kind != Token::Kind::Punct || token.text != "{")
-      throw scanner_.error(token.at, fmt::format("expected '{{' (a .cameramodel is a Python dict literal), got {}",
-                                                 describe(token)));
     while (true) {
       token = scanner_.next();
       if (token.kind == Token::Kind::Punct && token.text == "}") break;

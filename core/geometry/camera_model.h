@@ -19,6 +19,8 @@ class CameraModelError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// Immutable once made; copies share the mrcal state. The const methods may run on several threads
+// at once (mrcal's project/unproject keep no global state).
 class CameraModel {
  public:
   // lensmodel: an mrcal name such as "LENSMODEL_OPENCV8"; intrinsics: fx, fy, cx, cy, then distortion

@@ -18,6 +18,9 @@ inline void yuv_to_rgb(int y, int u, int v, uint8_t* rgb) {
   rgb[2] = clamp8((c + 516 * d + 128) >> 8);
 }
 inline uint8_t rgb_to_y(int r, int g, int b) { return clamp8(((66 * r + 129 * g + 25 * b + 128) >> 8) + 16); }
+// Full-range BT.601 luma (0.299, 0.587, 0.114 in 8-bit fixed point; the weights sum to 256, so a
+// grey stays exactly the same grey). GREY frames are full range: 0 is black, 255 is white.
+inline uint8_t rgb_to_full_range_luma(int r, int g, int b) { return uint8_t((77 * r + 150 * g + 29 * b + 128) >> 8); }
 inline uint8_t rgb_to_u(int r, int g, int b) { return clamp8(((-38 * r - 74 * g + 112 * b + 128) >> 8) + 128); }
 inline uint8_t rgb_to_v(int r, int g, int b) { return clamp8(((112 * r - 94 * g - 18 * b + 128) >> 8) + 128); }
 }  // namespace
@@ -34,7 +37,7 @@ void to_grey(const Frame& f, std::vector<uint8_t>& out) {
         for (int x = 0; x < f.width; ++x) dst[x] = row[2 * x];
         break;
       case PixelFormat::RGB24:
-        for (int x = 0; x < f.width; ++x) dst[x] = rgb_to_y(row[3 * x], row[3 * x + 1], row[3 * x + 2]);
+        for (int x = 0; x < f.width; ++x) dst[x] = rgb_to_full_range_luma(row[3 * x], row[3 * x + 1], row[3 * x + 2]);
         break;
     }
   }
@@ -75,7 +78,7 @@ Frame from_rgb24(const uint8_t* rgb, int width, int height, PixelFormat format) 
     switch (format) {
       case PixelFormat::RGB24: std::memcpy(row, px(0, y), size_t(width) * 3); break;
       case PixelFormat::GREY:
-        for (int x = 0; x < width; ++x) row[x] = rgb_to_y(px(x, y)[0], px(x, y)[1], px(x, y)[2]);
+        for (int x = 0; x < width; ++x) row[x] = rgb_to_full_range_luma(px(x, y)[0], px(x, y)[1], px(x, y)[2]);
         break;
       case PixelFormat::YUYV:
         for (int x = 0; x < width; x += 2) {

@@ -9,9 +9,11 @@
 
 namespace arpipe {
 
-// Writes width*height bytes of luma (no stride) into out.
+// Writes width*height bytes of luma (no stride) into out: the Y plane as it is for YUV formats
+// (limited range, 16..235), full-range BT.601 luma for RGB24 and GREY (0..255).
 void to_grey(const Frame& frame, std::vector<uint8_t>& out);
-// Writes width*height*3 bytes of RGB (no stride) into out. BT.601 limited range for YUV formats.
+// Writes width*height*3 bytes of RGB (no stride) into out. BT.601 limited range for YUV formats;
+// GREY is full range (R = G = B = the grey value).
 void to_rgb24(const Frame& frame, std::vector<uint8_t>& out);
 // Converts a packed RGB24 image (no stride) to the given format, into a new Frame (metadata left default).
 Frame from_rgb24(const uint8_t* rgb, int width, int height, PixelFormat format);

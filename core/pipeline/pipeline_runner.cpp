@@ -103,8 +103,12 @@ void PipelineRunner::capture_loop() {
 }
 
 void PipelineRunner::processing_loop() {
+  uint64_t expected_index = 0;
   while (auto ctx = to_process_->pop()) {
     busy_since_ns_ = monotonic_now_ns();
+    // Frames the live queue dropped are lost just like a sequence gap, so the next frame says so.
+    ctx->dropped_before += ctx->input_index - expected_index;
+    expected_index = ctx->input_index + 1;
     apply_pending_reconfigure();
     for (auto& stage : stages_) stage->process(*ctx);
     {

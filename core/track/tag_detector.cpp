@@ -141,6 +141,8 @@ const std::string& TagDetector::family() const { return impl_->family_name; }
 
 int TagDetector::code_count() const { return static_cast<int>(impl_->family->ncodes); }
 
+int TagDetector::border_cells() const { return impl_->family->width_at_border; }
+
 void TagDetector::detect(const uint8_t* grey, int width, int height, size_t stride,
                          std::vector<TagObservation>& out) noexcept {
   out.clear();

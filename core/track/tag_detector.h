@@ -30,6 +30,8 @@ class TagDetector {
   const std::string& family() const;
   // Number of distinct ids in the family (valid ids are 0 .. code_count()-1).
   int code_count() const;
+  // Code cells across the detected square (libapriltag's width_at_border: 8 for tag36h11).
+  int border_cells() const;
 
   // Detects tags in a grey image of width x height pixels whose rows are `stride` bytes apart.
   // Fills out with every detection of the family (corners in pixels, AprilTag order: bottom-left,

@@ -1,0 +1,134 @@
+// Replay of a recording as a frame source: real-time pacing against the steady clock, looping with
+// timestamps kept increasing, damaged frames skipped rather than thrown.
+#include "capture/replay_source.h"
+
+#include <fmt/format.h>
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <mutex>
+
+#include "capture/recording/recording_reader.h"
+#include "core/log.h"
+
+namespace arpipe {
+
+namespace {
+constexpr int64_t kFallbackFrameIntervalNs = 33'333'333;  // 30 fps, when a recording says nothing
+}
+
+struct ReplaySource::Impl {
+  SourceConfig config;
+  bool paced = true;
+  RecordingReader reader;
+  std::shared_ptr<const CameraModel> model;
+  int64_t loop_period_ns = 0;   // added to timestamps per completed pass
+  uint64_t loop_sequences = 0;  // added to sequence numbers per completed pass
+  size_t next_index = 0;
+  uint64_t passes = 0;
+  std::atomic<uint64_t> skipped{0};
+  // Pacing: the wall-clock time at which the recording's first frame was (virtually) delivered.
+  bool clock_started = false;
+  std::chrono::steady_clock::time_point wall_start;
+  std::mutex mutex;
+  std::condition_variable wake;
+  bool interrupted = false;
+
+  explicit Impl(const SourceConfig& c) : config(c), reader(c.path) {}
+};
+
+ReplaySource::ReplaySource(const SourceConfig& config) : impl_(std::make_unique<Impl>(config)) {
+  Impl& s = *impl_;
+  if (config.pacing != "timestamps" && config.pacing != "fast")
+    throw ConfigError(fmt::format("source.pacing is \"{}\", expected \"timestamps\" or \"fast\"", config.pacing));
+  s.paced = config.pacing == "timestamps";
+  const RecordingInfo& info = s.reader.info();
+  if (config.camera_model.empty()) {
+    s.model = std::make_shared<const CameraModel>(s.reader.camera_model());
+  } else {
+    auto model = std::make_shared<const CameraModel>(CameraModel::load(config.camera_model));
+    if (model->width() != info.width || model->height() != info.height)
+      throw CameraModelError(fmt::format(
+          "{}: imager size {}x{} differs from the {}x{} frames of the recording {}; it cannot describe this camera",
+          config.camera_model.string(), model->width(), model->height(), info.width, info.height,
+          config.path.string()));
+    s.model = std::move(model);
+  }
+  const size_t count = s.reader.frame_count();
+  if (count > 0) {
+    const FrameMetadata& first = s.reader.metadata(0);
+    const FrameMetadata& last = s.reader.metadata(count - 1);
+    int64_t interval = last.frame_duration_ns;
+    if (interval <= 0 && count > 1) interval = (last.exposure_start_ns - first.exposure_start_ns) / int64_t(count - 1);
+    if (interval <= 0) interval = kFallbackFrameIntervalNs;
+    s.loop_period_ns = std::max<int64_t>(last.exposure_start_ns - first.exposure_start_ns, 0) + interval;
+    s.loop_sequences = last.sequence >= first.sequence ? last.sequence - first.sequence + 1 : count;
+  }
+}
+
+ReplaySource::~ReplaySource() = default;
+
+std::string ReplaySource::describe() const {
+  const Impl& s = *impl_;
+  const RecordingInfo& info = s.reader.info();
+  return fmt::format("replay:{} ({} frames, {}x{} {}, pacing {}{})", s.config.path.string(), s.reader.frame_count(),
+                     info.width, info.height, pixel_format_name(info.pixel_format), s.config.pacing,
+                     s.config.loop ? ", loop" : "");
+}
+
+std::shared_ptr<const CameraModel> ReplaySource::camera_model() const { return impl_->model; }
+
+uint64_t ReplaySource::frames_skipped() const { return impl_->skipped; }
+
+void ReplaySource::interrupt() {
+  {
+    std::lock_guard lock(impl_->mutex);
+    impl_->interrupted = true;
+  }
+  impl_->wake.notify_all();
+}
+
+SourceStatus ReplaySource::next(Frame& frame) {
+  Impl& s = *impl_;
+  const size_t count = s.reader.frame_count();
+  if (count == 0) return SourceStatus::EndOfStream;
+  if (s.next_index == count) {
+    if (!s.config.loop) return SourceStatus::EndOfStream;
+    s.next_index = 0;
+    ++s.passes;
+  }
+  const size_t index = s.next_index;
+  const int64_t pass_shift_ns = int64_t(s.passes) * s.loop_period_ns;
+
+  if (s.paced) {
+    const int64_t due_ns =
+        s.reader.metadata(index).exposure_start_ns - s.reader.metadata(0).exposure_start_ns + pass_shift_ns;
+    std::unique_lock lock(s.mutex);
+    if (!s.clock_started) {
+      s.clock_started = true;
+      s.wall_start = std::chrono::steady_clock::now() - std::chrono::nanoseconds(due_ns);
+    }
+    const auto due = s.wall_start + std::chrono::nanoseconds(due_ns);
+    s.wake.wait_until(lock, due, [&] { return s.interrupted; });
+    if (s.interrupted) {
+      s.interrupted = false;
+      return SourceStatus::Retry;
+    }
+  }
+
+  s.next_index = index + 1;
+  try {
+    s.reader.read(index, frame);
+  } catch (const std::exception& e) {
+    ++s.skipped;
+    log::warn("replay {}: frame {} skipped: {}", s.config.path.string(), index, e.what());
+    return SourceStatus::Retry;
+  }
+  frame.meta.exposure_start_ns += pass_shift_ns + s.config.timestamp_offset_ns;
+  frame.meta.timestamp_offset_ns += s.config.timestamp_offset_ns;
+  frame.meta.sequence += s.passes * s.loop_sequences;
+  return SourceStatus::Frame;
+}
+
+}  // namespace arpipe

@@ -1,0 +1,638 @@
+// Config loading with toml++: overrides are merged into the parsed tree, then one schema walk
+// checks every key, type and range, so the file and the command line are validated alike.
+#include "core/config/config.h"
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include <apriltag/tag16h5.h>
+#include <apriltag/tag25h9.h>
+#include <apriltag/tag36h10.h>
+#include <apriltag/tag36h11.h>
+#include <apriltag/tagCircle21h7.h>
+#include <apriltag/tagCircle49h12.h>
+#include <apriltag/tagCustom48h12.h>
+#include <apriltag/tagStandard41h12.h>
+#include <apriltag/tagStandard52h13.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <functional>
+#include <limits>
+#include <numbers>
+#include <optional>
+#include <set>
+#include <sstream>
+
+namespace arpipe {
+
+namespace {
+
+constexpr double kRadiansPerDegree = std::numbers::pi / 180.0;
+constexpr const char* kOverridePrefix = "override '";
+
+struct TagFamily {
+  const char* name;
+  apriltag_family_t* (*create)();
+  void (*destroy)(apriltag_family_t*);
+};
+
+// libapriltag's own families; the id range of each comes from the library itself.
+constexpr TagFamily kTagFamilies[] = {
+    {"tag36h11", tag36h11_create, tag36h11_destroy},
+    {"tag25h9", tag25h9_create, tag25h9_destroy},
+    {"tag16h5", tag16h5_create, tag16h5_destroy},
+    {"tagStandard41h12", tagStandard41h12_create, tagStandard41h12_destroy},
+    {"tagStandard52h13", tagStandard52h13_create, tagStandard52h13_destroy},
+    {"tagCircle21h7", tagCircle21h7_create, tagCircle21h7_destroy},
+    {"tagCircle49h12", tagCircle49h12_create, tagCircle49h12_destroy},
+    {"tagCustom48h12", tagCustom48h12_create, tagCustom48h12_destroy},
+    {"tag36h10", tag36h10_create, tag36h10_destroy},
+};
+
+int64_t tag_family_code_count(const TagFamily& family) {
+  apriltag_family_t* created = family.create();
+  const int64_t count = created->ncodes;
+  family.destroy(created);
+  return count;
+}
+
+std::string join(const std::vector<std::string>& items) {
+  std::string out;
+  for (const auto& item : items) out += (out.empty() ? "" : ", ") + item;
+  return out;
+}
+
+std::string_view type_phrase(const toml::node& node) {
+  switch (node.type()) {
+    case toml::node_type::string: return "a string";
+    case toml::node_type::integer: return "an integer";
+    case toml::node_type::floating_point: return "a float";
+    case toml::node_type::boolean: return "a boolean";
+    case toml::node_type::date: return "a date";
+    case toml::node_type::time: return "a time";
+    case toml::node_type::date_time: return "a date-time";
+    case toml::node_type::array: return "an array";
+    case toml::node_type::table: return "a table";
+    case toml::node_type::none: break;
+  }
+  return "nothing";
+}
+
+// "file:line:column" for file nodes; overrides have no useful line, so they name themselves.
+std::string place_of(const toml::source_region& region, const std::string& fallback) {
+  if (!region.path) return fallback;
+  const std::string& path = *region.path;
+  if (path.rfind(kOverridePrefix, 0) == 0) return path;
+  return fmt::format("{}:{}:{}", path, region.begin.line, region.begin.column);
+}
+
+std::string format_toml_float(double value) {
+  std::string text = fmt::format("{}", value);
+  if (text.find_first_of(".eEn") == std::string::npos) text += ".0";  // TOML floats need a point
+  return text;
+}
+
+std::string toml_string(std::string_view text) {
+  std::string out = "\"";
+  for (const char c : text) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + "\"";
+}
+
+// ---- The schema walk ----------------------------------------------------------------------------
+
+class ConfigReader {
+ public:
+  explicit ConfigReader(std::string source) : source_(std::move(source)) {}
+
+  [[noreturn]] void fail(const toml::node& node, const std::string& key, const std::string& expected) const {
+    throw ConfigError(fmt::format("{}: '{}' expected {}", place_of(node.source(), source_), key, expected));
+  }
+  [[noreturn]] void fail_got(const toml::node& node, const std::string& key, const std::string& expected,
+                             const std::string& got) const {
+    throw ConfigError(fmt::format("{}: '{}' expected {}, got {}", place_of(node.source(), source_), key, expected, got));
+  }
+
+  // Throws on the first key (in file order) that is not in `allowed`.
+  void check_keys(const toml::table& table, const std::string& prefix, const std::vector<std::string>& allowed,
+                  const std::string& where) const {
+    const toml::key* first = nullptr;
+    const toml::node* first_value = nullptr;
+    for (auto&& [key, value] : table) {
+      if (std::find(allowed.begin(), allowed.end(), key.str()) != allowed.end()) continue;
+      if (first == nullptr || earlier(region_of(key, value), region_of(*first, *first_value))) {
+        first = &key;
+        first_value = &value;
+      }
+    }
+    if (first == nullptr) return;
+    throw ConfigError(fmt::format("{}: unknown key '{}{}'; allowed keys in {}: {}",
+                                  place_of(region_of(*first, *first_value), source_), prefix, first->str(), where,
+                                  join(allowed)));
+  }
+
+  const toml::table* table(const toml::table& parent, const std::string& prefix, const char* key) const {
+    const toml::node* node = parent.get(key);
+    if (node == nullptr) return nullptr;
+    if (!node->is_table()) fail_got(*node, prefix + key, "a table", std::string(type_phrase(*node)));
+    return node->as_table();
+  }
+
+  // An array whose elements are all tables ([[name]] or an inline array of inline tables).
+  const toml::array* array_of_tables(const toml::table& parent, const std::string& prefix, const char* key) const {
+    const toml::node* node = parent.get(key);
+    if (node == nullptr) return nullptr;
+    if (!node->is_array()) fail_got(*node, prefix + key, "an array of tables", std::string(type_phrase(*node)));
+    const toml::array& array = *node->as_array();
+    for (size_t i = 0; i < array.size(); ++i)
+      if (!array[i].is_table())
+        fail_got(array[i], fmt::format("{}{}[{}]", prefix, key, i), "a table", std::string(type_phrase(array[i])));
+    return &array;
+  }
+
+  void read(const toml::table& t, const std::string& prefix, const char* key, bool& out) const {
+    const toml::node* node = t.get(key);
+    if (node == nullptr) return;
+    if (!node->is_boolean()) fail_got(*node, prefix + key, "a boolean (true or false)", std::string(type_phrase(*node)));
+    out = node->as_boolean()->get();
+  }
+
+  void read(const toml::table& t, const std::string& prefix, const char* key, int64_t& out,
+            int64_t min = std::numeric_limits<int64_t>::min(), int64_t max = std::numeric_limits<int64_t>::max()) const {
+    const toml::node* node = t.get(key);
+    if (node == nullptr) return;
+    if (!node->is_integer()) fail_got(*node, prefix + key, "an integer", std::string(type_phrase(*node)));
+    const int64_t value = node->as_integer()->get();
+    if (value < min || value > max) fail_got(*node, prefix + key, range_phrase("an integer", min, max), fmt::format("{}", value));
+    out = value;
+  }
+
+  void read(const toml::table& t, const std::string& prefix, const char* key, int& out,
+            int64_t min = std::numeric_limits<int>::min(), int64_t max = std::numeric_limits<int>::max()) const {
+    int64_t value = out;
+    read(t, prefix, key, value, std::max<int64_t>(min, std::numeric_limits<int>::min()),
+         std::min<int64_t>(max, std::numeric_limits<int>::max()));
+    out = static_cast<int>(value);
+  }
+
+  // Numbers accept integers too (size_m = 1 means 1.0). `valid` says whether a finite value is in
+  // range and `expected` describes the range for the message.
+  void read(const toml::table& t, const std::string& prefix, const char* key, double& out,
+            const std::function<bool(double)>& valid = nullptr, const std::string& expected = "a number") const {
+    const toml::node* node = t.get(key);
+    if (node == nullptr) return;
+    const double value = number(*node, prefix + key, expected);
+    if (valid && !valid(value)) fail_got(*node, prefix + key, expected, format_toml_float(value));
+    out = value;
+  }
+
+  void read(const toml::table& t, const std::string& prefix, const char* key, std::string& out,
+            const std::vector<std::string>& choices = {}) const {
+    const toml::node* node = t.get(key);
+    if (node == nullptr) return;
+    const std::string expected = choices.empty() ? "a string" : "one of " + join(quoted(choices));
+    if (!node->is_string()) fail_got(*node, prefix + key, expected, std::string(type_phrase(*node)));
+    const std::string& value = node->as_string()->get();
+    if (!choices.empty() && std::find(choices.begin(), choices.end(), value) == choices.end())
+      fail_got(*node, prefix + key, expected, toml_string(value));
+    out = value;
+  }
+
+  void read(const toml::table& t, const std::string& prefix, const char* key, std::filesystem::path& out) const {
+    std::string text = out.string();
+    read(t, prefix, key, text);
+    out = text;
+  }
+
+  void read(const toml::table& t, const std::string& prefix, const char* key, Vec3& out,
+            const std::function<bool(double)>& valid = nullptr, const std::string& item_expected = "numbers") const {
+    const toml::node* node = t.get(key);
+    if (node == nullptr) return;
+    const std::string expected = "an array of 3 " + item_expected + " [x, y, z]";
+    if (!node->is_array()) fail_got(*node, prefix + key, expected, std::string(type_phrase(*node)));
+    const toml::array& array = *node->as_array();
+    if (array.size() != 3) fail_got(*node, prefix + key, expected, fmt::format("{} items", array.size()));
+    Vec3 value{};
+    for (size_t i = 0; i < 3; ++i) {
+      const std::string item_key = fmt::format("{}{}[{}]", prefix, key, i);
+      value[i] = number(array[i], item_key, expected);
+      if (valid && !valid(value[i])) fail_got(array[i], item_key, expected, format_toml_float(value[i]));
+    }
+    out = value;
+  }
+
+  // Degrees in the file, radians in the struct.
+  void read_degrees(const toml::table& t, const std::string& prefix, const char* key, double& out_rad) const {
+    if (t.get(key) == nullptr) return;  // keep the default bit for bit
+    double degrees = 0;
+    read(t, prefix, key, degrees);
+    out_rad = degrees * kRadiansPerDegree;
+  }
+
+ private:
+  static toml::source_region region_of(const toml::key& key, const toml::node& value) {
+    return key.source().path ? key.source() : value.source();
+  }
+  static bool earlier(const toml::source_region& a, const toml::source_region& b) {
+    return std::tie(a.begin.line, a.begin.column) < std::tie(b.begin.line, b.begin.column);
+  }
+  static std::vector<std::string> quoted(const std::vector<std::string>& items) {
+    std::vector<std::string> out;
+    for (const auto& item : items) out.push_back(toml_string(item));
+    return out;
+  }
+  static std::string range_phrase(const std::string& what, int64_t min, int64_t max) {
+    const bool has_min = min != std::numeric_limits<int64_t>::min() && min != std::numeric_limits<int>::min();
+    const bool has_max = max != std::numeric_limits<int64_t>::max() && max != std::numeric_limits<int>::max();
+    if (has_min && has_max) return fmt::format("{} in [{}, {}]", what, min, max);
+    if (has_min) return fmt::format("{} >= {}", what, min);
+    if (has_max) return fmt::format("{} <= {}", what, max);
+    return what;
+  }
+
+  double number(const toml::node& node, const std::string& key, const std::string& expected) const {
+    double value;
+    if (node.is_integer())
+      value = static_cast<double>(node.as_integer()->get());
+    else if (node.is_floating_point())
+      value = node.as_floating_point()->get();
+    else
+      fail_got(node, key, expected, std::string(type_phrase(node)));
+    if (!std::isfinite(value)) fail_got(node, key, "a finite number", format_toml_float(value));
+    return value;
+  }
+
+  std::string source_;
+};
+
+const auto positive = [](double v) { return v > 0; };
+const auto non_negative = [](double v) { return v >= 0; };
+
+void read_source(const ConfigReader& r, const toml::table& t, SourceConfig& out) {
+  const std::string p = "source.";
+  r.check_keys(t, p, {"type", "path", "pacing", "loop", "timestamp_offset_ns", "camera_model"}, "[source]");
+  r.read(t, p, "type", out.type, {"replay"});
+  r.read(t, p, "path", out.path);
+  r.read(t, p, "pacing", out.pacing, {"timestamps", "fast"});
+  r.read(t, p, "loop", out.loop);
+  r.read(t, p, "timestamp_offset_ns", out.timestamp_offset_ns);
+  r.read(t, p, "camera_model", out.camera_model);
+}
+
+void read_track(const ConfigReader& r, const toml::table& t, TrackConfig& out) {
+  const std::string p = "track.";
+  r.check_keys(t, p,
+               {"enabled", "family", "bundle", "quad_decimate", "quad_sigma", "threads", "max_hamming",
+                "min_decision_margin", "ambiguity_ratio"},
+               "[track]");
+  r.read(t, p, "enabled", out.enabled);
+  std::vector<std::string> families;
+  for (const auto& family : kTagFamilies) families.emplace_back(family.name);
+  r.read(t, p, "family", out.family, families);
+  r.read(t, p, "quad_decimate", out.quad_decimate, [](double v) { return v >= 1; }, "a number >= 1");
+  r.read(t, p, "quad_sigma", out.quad_sigma);  // negative sharpens in libapriltag, so any value goes
+  r.read(t, p, "threads", out.threads, 1, 64);
+  r.read(t, p, "max_hamming", out.max_hamming, 0, 3);  // libapriltag corrects at most 3 bits
+  r.read(t, p, "min_decision_margin", out.min_decision_margin, non_negative, "a number >= 0");
+  r.read(t, p, "ambiguity_ratio", out.ambiguity_ratio, [](double v) { return v >= 1; }, "a number >= 1");
+
+  if (const toml::array* bundle = r.array_of_tables(t, p, "bundle")) {
+    const auto family = std::find_if(std::begin(kTagFamilies), std::end(kTagFamilies),
+                                     [&](const TagFamily& f) { return out.family == f.name; });
+    const int64_t code_count = tag_family_code_count(*family);
+    out.bundle.clear();
+    std::set<int> ids;
+    for (size_t i = 0; i < bundle->size(); ++i) {
+      const toml::table& tag_table = *(*bundle)[i].as_table();
+      const std::string tp = fmt::format("track.bundle[{}].", i);
+      r.check_keys(tag_table, tp, {"id", "size_m", "center_m", "yaw_deg"}, "[[track.bundle]]");
+      BundleTag tag;
+      r.read(tag_table, tp, "id", tag.id, 0, code_count - 1);
+      r.read(tag_table, tp, "size_m", tag.size_m, positive, "a number > 0");
+      r.read(tag_table, tp, "center_m", tag.center_m);
+      r.read_degrees(tag_table, tp, "yaw_deg", tag.yaw_rad);
+      if (!ids.insert(tag.id).second) {
+        const toml::node* id = tag_table.get("id");
+        r.fail_got(id != nullptr ? *id : (*bundle)[i], tp + "id", "an id not used by another tag of the bundle",
+                   fmt::format("{} a second time", tag.id));
+      }
+      out.bundle.push_back(tag);
+    }
+    if (out.enabled && out.bundle.empty())
+      r.fail(*t.get("bundle"), p + "bundle", "at least one tag while tracking is enabled");
+  }
+  // Without a bundle key the default bundle (tag 0) stays, and tag 0 exists in every family.
+}
+
+void read_render(const ConfigReader& r, const toml::table& t, RenderConfig& out) {
+  const std::string p = "render.";
+  r.check_keys(t, p, {"enabled", "objects", "light_direction", "light_color", "ambient", "msaa_samples", "egl_platform"},
+               "[render]");
+  r.read(t, p, "enabled", out.enabled);
+  if (const toml::array* objects = r.array_of_tables(t, p, "objects")) {
+    out.objects.clear();
+    for (size_t i = 0; i < objects->size(); ++i) {
+      const toml::table& object_table = *(*objects)[i].as_table();
+      const std::string op = fmt::format("render.objects[{}].", i);
+      r.check_keys(object_table, op, {"mesh", "position_m", "yaw_deg", "scale", "color"}, "[[render.objects]]");
+      SceneObject object;
+      r.read(object_table, op, "mesh", object.mesh);
+      if (object.mesh.empty()) r.fail(*object_table.get("mesh"), op + "mesh", "\"builtin:cube\", \"builtin:pyramid\" or a glTF file");
+      r.read(object_table, op, "position_m", object.position_m);
+      r.read_degrees(object_table, op, "yaw_deg", object.yaw_rad);
+      r.read(object_table, op, "scale", object.scale, positive, "a number > 0");
+      r.read(object_table, op, "color", object.color, non_negative, "numbers >= 0");
+      out.objects.push_back(object);
+    }
+  }
+  r.read(t, p, "light_direction", out.light_direction);
+  const double length = norm(out.light_direction);
+  if (length == 0) r.fail(*t.get("light_direction"), p + "light_direction", "a non-zero direction");
+  // A vector already of unit length is kept bit for bit, so printing and reading a config is exact.
+  if (std::abs(length - 1.0) > 1e-12) out.light_direction = normalized(out.light_direction);
+  r.read(t, p, "light_color", out.light_color, non_negative, "numbers >= 0");
+  r.read(t, p, "ambient", out.ambient, non_negative, "numbers >= 0");
+  r.read(t, p, "msaa_samples", out.msaa_samples);
+  if (out.msaa_samples != 0 && out.msaa_samples != 1 && out.msaa_samples != 2 && out.msaa_samples != 4)
+    r.fail_got(*t.get("msaa_samples"), p + "msaa_samples", "one of 0, 1, 2, 4", fmt::format("{}", out.msaa_samples));
+  r.read(t, p, "egl_platform", out.egl_platform, {"auto", "surfaceless", "device"});
+}
+
+void read_sinks(const ConfigReader& r, const toml::table& t, SinksConfig& out) {
+  r.check_keys(t, "sinks.", {"png", "y4m", "recording", "results"}, "[sinks]");
+  if (const toml::table* png = r.table(t, "sinks.", "png")) {
+    r.check_keys(*png, "sinks.png.", {"enabled", "dir", "every"}, "[sinks.png]");
+    r.read(*png, "sinks.png.", "enabled", out.png.enabled);
+    r.read(*png, "sinks.png.", "dir", out.png.dir);
+    r.read(*png, "sinks.png.", "every", out.png.every, 1);
+  }
+  if (const toml::table* y4m = r.table(t, "sinks.", "y4m")) {
+    r.check_keys(*y4m, "sinks.y4m.", {"enabled", "path"}, "[sinks.y4m]");
+    r.read(*y4m, "sinks.y4m.", "enabled", out.y4m.enabled);
+    r.read(*y4m, "sinks.y4m.", "path", out.y4m.path);
+  }
+  if (const toml::table* recording = r.table(t, "sinks.", "recording")) {
+    r.check_keys(*recording, "sinks.recording.", {"enabled", "path"}, "[sinks.recording]");
+    r.read(*recording, "sinks.recording.", "enabled", out.recording.enabled);
+    r.read(*recording, "sinks.recording.", "path", out.recording.path);
+  }
+  if (const toml::table* results = r.table(t, "sinks.", "results")) {
+    r.check_keys(*results, "sinks.results.", {"enabled", "path"}, "[sinks.results]");
+    r.read(*results, "sinks.results.", "enabled", out.results.enabled);
+    r.read(*results, "sinks.results.", "path", out.results.path);
+  }
+}
+
+void read_pipeline(const ConfigReader& r, const toml::table& t, PipelineConfig& out) {
+  const std::string p = "pipeline.";
+  r.check_keys(t, p, {"queue_depth", "max_frames", "log_level"}, "[pipeline]");
+  r.read(t, p, "queue_depth", out.queue_depth, 1);
+  r.read(t, p, "max_frames", out.max_frames, 0);
+  r.read(t, p, "log_level", out.log_level, {"error", "warning", "info", "debug"});
+}
+
+Config read_config(const toml::table& root, const std::string& source) {
+  const ConfigReader r(source);
+  Config config;
+  config.file = source;
+  r.check_keys(root, "", {"source", "track", "render", "sinks", "pipeline"}, "the top level");
+  if (const toml::table* t = r.table(root, "", "source")) read_source(r, *t, config.source);
+  if (const toml::table* t = r.table(root, "", "track")) read_track(r, *t, config.track);
+  if (const toml::table* t = r.table(root, "", "render")) read_render(r, *t, config.render);
+  if (const toml::table* t = r.table(root, "", "sinks")) read_sinks(r, *t, config.sinks);
+  if (const toml::table* t = r.table(root, "", "pipeline")) read_pipeline(r, *t, config.pipeline);
+  return config;
+}
+
+// ---- Overrides ---------------------------------------------------------------------------------
+
+[[noreturn]] void override_error(const std::string& label, const std::string& what) {
+  throw ConfigError(fmt::format("{}: {}", label, what));
+}
+
+bool is_bare_key(std::string_view key) {
+  return !key.empty() && std::all_of(key.begin(), key.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-';
+  });
+}
+
+// Unquoted words ("fast", "out/run1") are taken as strings, so a shell need not quote quotes.
+bool looks_like_bare_word(std::string_view value) {
+  return !value.empty() && std::all_of(value.begin(), value.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || std::strchr("_-./:+", c) != nullptr;
+  });
+}
+
+std::string_view trim(std::string_view text) {
+  while (!text.empty() && std::isspace(static_cast<unsigned char>(text.front()))) text.remove_prefix(1);
+  while (!text.empty() && std::isspace(static_cast<unsigned char>(text.back()))) text.remove_suffix(1);
+  return text;
+}
+
+void merge_override(toml::table& target, toml::table& source, const std::string& prefix, const std::string& label);
+
+// "render.objects.0.scale": a table of integer keys, merged into the existing array's elements.
+void merge_override_into_array(toml::array& target, toml::table& source, const std::string& prefix,
+                               const std::string& label) {
+  for (auto&& [key, value] : source) {
+    size_t index = 0;
+    const std::string text(key.str());
+    if (text.empty() || !std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; }) ||
+        (index = std::stoul(text)) >= target.size())
+      override_error(label, fmt::format("'{}' has {} elements; '{}' is not an index into it", prefix,
+                                        target.size(), text));
+    const std::string element = fmt::format("{}[{}]", prefix, index);
+    if (value.is_table() && !value.as_table()->is_inline()) {
+      if (!target[index].is_table()) override_error(label, fmt::format("'{}' is not a table", element));
+      merge_override(*target[index].as_table(), *value.as_table(), element, label);
+    } else {
+      target.erase(target.cbegin() + static_cast<std::ptrdiff_t>(index));
+      target.insert(target.cbegin() + static_cast<std::ptrdiff_t>(index), std::move(value));
+    }
+  }
+}
+
+// The dotted path of the first implicit table below `node` that is indexed like an array ("bundle.0").
+std::optional<std::string> first_indexed_path(const toml::node& node, const std::string& dotted) {
+  if (!node.is_table() || node.as_table()->is_inline()) return std::nullopt;
+  for (auto&& [key, value] : *node.as_table()) {
+    if (!key.str().empty() && std::isdigit(static_cast<unsigned char>(key.str().front()))) return dotted;
+    if (auto found = first_indexed_path(value, fmt::format("{}.{}", dotted, key.str()))) return found;
+  }
+  return std::nullopt;
+}
+
+// Dotted keys make implicit (non-inline) tables: those descend; any other value replaces the key.
+void merge_override(toml::table& target, toml::table& source, const std::string& prefix, const std::string& label) {
+  for (auto&& [key, value] : source) {
+    const std::string dotted = prefix.empty() ? std::string(key.str()) : fmt::format("{}.{}", prefix, key.str());
+    toml::node* existing = target.get(key.str());
+    if (existing != nullptr && value.is_table() && !value.as_table()->is_inline()) {
+      if (existing->is_table()) {
+        merge_override(*existing->as_table(), *value.as_table(), dotted, label);
+        continue;
+      }
+      if (existing->is_array()) {
+        merge_override_into_array(*existing->as_array(), *value.as_table(), dotted, label);
+        continue;
+      }
+      override_error(label, fmt::format("'{}' is {}, not a table", dotted, type_phrase(*existing)));
+    }
+    if (existing == nullptr)
+      if (const auto indexed = first_indexed_path(value, dotted))
+        override_error(label, fmt::format("'{}' is not in the file, so it has no elements to index; set the whole "
+                                          "array instead, e.g. {}=[{{...}}]",
+                                          *indexed, *indexed));
+    target.insert_or_assign(key, std::move(value));
+  }
+}
+
+void apply_override(toml::table& root, const std::string& assignment) {
+  const std::string label = fmt::format("{}{}'", kOverridePrefix, assignment);
+  const size_t equals = assignment.find('=');
+  if (equals == std::string::npos) override_error(label, "expected section.key=value");
+  const std::string_view key = trim(std::string_view(assignment).substr(0, equals));
+  const std::string_view value = trim(std::string_view(assignment).substr(equals + 1));
+  size_t start = 0;
+  while (true) {
+    const size_t dot = key.find('.', start);
+    if (!is_bare_key(key.substr(start, dot == std::string_view::npos ? dot : dot - start)))
+      override_error(label, fmt::format("'{}' is not a dotted key such as track.family", key));
+    if (dot == std::string_view::npos) break;
+    start = dot + 1;
+  }
+  toml::table parsed;
+  try {
+    parsed = toml::parse(fmt::format("{} = {}", key, value), std::string_view(label));
+  } catch (const toml::parse_error& e) {
+    if (!looks_like_bare_word(value))
+      override_error(label, fmt::format("the value is not valid TOML ({}); quote strings", e.description()));
+    parsed = toml::parse(fmt::format("{} = {}", key, toml_string(value)), std::string_view(label));
+  }
+  merge_override(root, parsed, "", label);
+}
+
+Config parse_table(toml::table root, const std::string& source_name, const std::vector<std::string>& overrides) {
+  for (const std::string& assignment : overrides) apply_override(root, assignment);
+  return read_config(root, source_name);
+}
+
+}  // namespace
+
+Config parse_config(const std::string& text, const std::string& source_name, const std::vector<std::string>& overrides) {
+  toml::table root;
+  try {
+    root = toml::parse(text, std::string_view(source_name));
+  } catch (const toml::parse_error& e) {
+    throw ConfigError(fmt::format("{}: TOML syntax error: {}", place_of(e.source(), source_name), e.description()));
+  }
+  return parse_table(std::move(root), source_name, overrides);
+}
+
+Config load_config(const std::filesystem::path& path, const std::vector<std::string>& overrides) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw ConfigError(fmt::format("{}: cannot read config: it is a directory", path.string()));
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw ConfigError(fmt::format("{}: cannot read config: {}", path.string(), std::strerror(errno)));
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw ConfigError(fmt::format("{}: cannot read config: {}", path.string(), std::strerror(errno)));
+  Config config = parse_config(text.str(), path.string(), overrides);
+  config.file = path;
+  return config;
+}
+
+std::string default_config_toml() {
+  const Config d;
+  const auto f = [](double v) { return format_toml_float(v); };
+  const auto vec = [&](const Vec3& v) { return fmt::format("[{}, {}, {}]", f(v[0]), f(v[1]), f(v[2])); };
+  const auto b = [](bool v) { return std::string(v ? "true" : "false"); };
+  const auto s = [](const std::string& text) { return toml_string(text); };
+  std::string out;
+  // One "key = value" line, its comment aligned in a column when it fits.
+  const auto entry = [&out](std::string_view key, const std::string& value, std::string_view comment = {}) {
+    const std::string assignment = fmt::format("{} = {}", key, value);
+    if (comment.empty())
+      out += assignment + "\n";
+    else
+      out += fmt::format("{:<32}# {}\n", assignment + " ", comment);
+  };
+  out += "# arpiped configuration: every key is optional and shows its default; unknown keys are errors.\n";
+  out += "# Units: metres, nanoseconds, and degrees for angles (the code works in radians).\n";
+
+  out += "\n[source]\n";
+  entry("type", s(d.source.type), "\"replay\" (live sources come later)");
+  entry("path", s(d.source.path.string()), "replay: the recording directory");
+  entry("pacing", s(d.source.pacing), "\"timestamps\" (real time) or \"fast\"");
+  entry("loop", b(d.source.loop), "replay: start again at the end");
+  entry("timestamp_offset_ns", fmt::format("{}", d.source.timestamp_offset_ns),
+        "added to every exposure start of this camera");
+  entry("camera_model", s(d.source.camera_model.string()), "a .cameramodel to use instead of the recording's");
+
+  out += "\n[track]\n";
+  entry("enabled", b(d.track.enabled));
+  std::vector<std::string> families;
+  for (const auto& family : kTagFamilies) families.emplace_back(family.name);
+  entry("family", s(d.track.family), "one of " + join(families));
+  entry("quad_decimate", f(d.track.quad_decimate), ">= 1: find quads in an image this many times smaller");
+  entry("quad_sigma", f(d.track.quad_sigma), "blur before finding quads (negative sharpens)");
+  entry("threads", fmt::format("{}", d.track.threads), "detector threads, 1..64");
+  entry("max_hamming", fmt::format("{}", d.track.max_hamming), "bit errors corrected, 0..3");
+  entry("min_decision_margin", f(d.track.min_decision_margin), "weaker detections are ignored");
+  entry("ambiguity_ratio", f(d.track.ambiguity_ratio), ">= 1: IPPE's two poses closer than this error ratio are ambiguous");
+  out += "\n# The anchor: one [[track.bundle]] per tag, placed in the world (anchor) frame, lying in z = 0.\n";
+  for (const BundleTag& tag : d.track.bundle) {
+    out += "[[track.bundle]]\n";
+    entry("id", fmt::format("{}", tag.id), "unique, and within the family");
+    entry("size_m", f(tag.size_m), "> 0: edge of the black square (AprilTag's tag size)");
+    entry("center_m", vec(tag.center_m), "tag centre in the world frame");
+    entry("yaw_deg", f(tag.yaw_rad / kRadiansPerDegree), "turn of the tag's x axis about world z");
+  }
+
+  out += "\n[render]\n";
+  entry("enabled", b(d.render.enabled));
+  entry("light_direction", vec(d.render.light_direction), "world frame, towards the light; normalised on load");
+  entry("light_color", vec(d.render.light_color), "linear RGB, >= 0");
+  entry("ambient", vec(d.render.ambient), "linear RGB, >= 0");
+  entry("msaa_samples", fmt::format("{}", d.render.msaa_samples), "0, 1, 2 or 4");
+  entry("egl_platform", s(d.render.egl_platform), "\"auto\", \"surfaceless\" or \"device\"");
+  out += "\n# Virtual objects: one [[render.objects]] each, placed in the world (anchor) frame.\n";
+  for (const SceneObject& object : d.render.objects) {
+    out += "[[render.objects]]\n";
+    entry("mesh", s(object.mesh), "\"builtin:cube\", \"builtin:pyramid\" or a glTF 2.0 file");
+    entry("position_m", vec(object.position_m));
+    entry("yaw_deg", f(object.yaw_rad / kRadiansPerDegree), "about world z");
+    entry("scale", f(object.scale), "> 0");
+    entry("color", vec(object.color), "linear base colour of builtin meshes, >= 0");
+  }
+
+  out += "\n[sinks.png]\n";
+  entry("enabled", b(d.sinks.png.enabled));
+  entry("dir", s(d.sinks.png.dir.string()));
+  entry("every", fmt::format("{}", d.sinks.png.every), ">= 1: write every Nth frame");
+  out += "\n[sinks.y4m]\n";
+  entry("enabled", b(d.sinks.y4m.enabled));
+  entry("path", s(d.sinks.y4m.path.string()));
+  out += "\n[sinks.recording]\n";
+  entry("enabled", b(d.sinks.recording.enabled));
+  entry("path", s(d.sinks.recording.path.string()));
+  out += "\n[sinks.results]                # per-frame pose, tracking state and timings as JSON lines\n";
+  entry("enabled", b(d.sinks.results.enabled));
+  entry("path", s(d.sinks.results.path.string()));
+
+  out += "\n[pipeline]\n";
+  entry("queue_depth", fmt::format("{}", d.pipeline.queue_depth), ">= 1: frames between threads");
+  entry("max_frames", fmt::format("{}", d.pipeline.max_frames), "stop after this many frames; 0 = no limit");
+  entry("log_level", s(d.pipeline.log_level), "\"error\", \"warning\", \"info\" or \"debug\"");
+  return out;
+}
+
+}  // namespace arpipe

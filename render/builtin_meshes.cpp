@@ -1,0 +1,85 @@
+// The procedural meshes a scene can name without a file ("builtin:cube", "builtin:pyramid"):
+// base on z = 0, centred on the object origin in x and y, about 6 cm across.
+#include "render/builtin_meshes.h"
+
+namespace arpipe {
+namespace {
+
+class MeshBuilder {
+ public:
+  uint32_t add_vertex(const Vec3& position, const Vec3& normal) {
+    for (int axis = 0; axis < 3; ++axis) {
+      mesh_.positions.push_back(static_cast<float>(position[static_cast<size_t>(axis)]));
+      mesh_.normals.push_back(static_cast<float>(normal[static_cast<size_t>(axis)]));
+    }
+    return static_cast<uint32_t>(mesh_.vertex_count() - 1);
+  }
+  void add_triangle(uint32_t a, uint32_t b, uint32_t c) { mesh_.indices.insert(mesh_.indices.end(), {a, b, c}); }
+
+  // Flat parallelogram origin + s*u + t*v, s and t in [0, 1]; u x v points outwards.
+  void add_grid(const Vec3& origin, const Vec3& u, const Vec3& v, int n) {
+    const Vec3 normal = normalized(cross(u, v));
+    const uint32_t first = static_cast<uint32_t>(mesh_.vertex_count());
+    for (int j = 0; j <= n; ++j)
+      for (int i = 0; i <= n; ++i) add_vertex(origin + (double(i) / n) * u + (double(j) / n) * v, normal);
+    auto at = [&](int i, int j) { return first + static_cast<uint32_t>(j * (n + 1) + i); };
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        add_triangle(at(i, j), at(i + 1, j), at(i + 1, j + 1));
+        add_triangle(at(i, j), at(i + 1, j + 1), at(i, j + 1));
+      }
+  }
+
+  // Flat triangle a, b, c (counter-clockwise seen from outside), split into n*n triangles.
+  void add_subdivided_triangle(const Vec3& a, const Vec3& b, const Vec3& c, int n) {
+    const Vec3 normal = normalized(cross(b - a, c - a));
+    const uint32_t first = static_cast<uint32_t>(mesh_.vertex_count());
+    // Row j holds the points a + i/n (b - a) + j/n (c - a) for i + j <= n.
+    std::vector<uint32_t> row_start;
+    for (int j = 0; j <= n; ++j) {
+      row_start.push_back(static_cast<uint32_t>(mesh_.vertex_count()) - first);
+      for (int i = 0; i + j <= n; ++i) add_vertex(a + (double(i) / n) * (b - a) + (double(j) / n) * (c - a), normal);
+    }
+    auto at = [&](int i, int j) { return first + row_start[static_cast<size_t>(j)] + static_cast<uint32_t>(i); };
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i + j < n; ++i) {
+        add_triangle(at(i, j), at(i + 1, j), at(i, j + 1));
+        if (i + j < n - 1) add_triangle(at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+      }
+  }
+
+  Mesh finish() {
+    mesh_.parts = {MeshPart{0, static_cast<uint32_t>(mesh_.indices.size()), {1, 1, 1, 1}}};
+    return std::move(mesh_);
+  }
+
+ private:
+  Mesh mesh_;
+};
+
+}  // namespace
+
+Mesh make_cube_mesh(double edge_m, int subdivisions) {
+  const double s = edge_m, h = edge_m / 2;
+  MeshBuilder builder;
+  builder.add_grid({-h, -h, s}, {s, 0, 0}, {0, s, 0}, subdivisions);  // top, +z
+  builder.add_grid({-h, -h, 0}, {0, s, 0}, {s, 0, 0}, subdivisions);  // bottom, -z
+  builder.add_grid({h, -h, 0}, {0, s, 0}, {0, 0, s}, subdivisions);   // +x
+  builder.add_grid({-h, -h, 0}, {0, 0, s}, {0, s, 0}, subdivisions);  // -x
+  builder.add_grid({-h, h, 0}, {0, 0, s}, {s, 0, 0}, subdivisions);   // +y
+  builder.add_grid({-h, -h, 0}, {s, 0, 0}, {0, 0, s}, subdivisions);  // -y
+  return builder.finish();
+}
+
+Mesh make_pyramid_mesh(double base_m, double height_m, int subdivisions) {
+  const double s = base_m, h = base_m / 2;
+  const Vec3 apex{0, 0, height_m};
+  MeshBuilder builder;
+  builder.add_grid({-h, -h, 0}, {0, s, 0}, {s, 0, 0}, subdivisions);  // base, -z
+  const Vec3 corners[4] = {{-h, -h, 0}, {h, -h, 0}, {h, h, 0}, {-h, h, 0}};  // counter-clockwise about +z
+  for (int side = 0; side < 4; ++side)
+    builder.add_subdivided_triangle(corners[side], corners[(side + 1) % 4], apex, subdivisions);
+  return builder.finish();
+}
+
+}  // namespace arpipe

@@ -1,0 +1,184 @@
+// The composite stage: puts the virtual layer over the camera frame into ctx.output (RGB24), in
+// linear light with premultiplied alpha, doing GL work only inside the layer's drawn rectangle.
+#include "render/composite_stage.h"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cstring>
+
+#include "core/image/pixel_convert.h"
+#include "core/log.h"
+#include "render/gl_error.h"
+#include "render/render_errors.h"
+
+namespace arpipe {
+namespace {
+
+// One triangle over the whole viewport; the scissor rectangle limits it to the drawn region.
+constexpr std::string_view kVertexShader = R"glsl(#version 300 es
+void main() {
+  vec2 corner = vec2(float((gl_VertexID & 1) << 2), float((gl_VertexID & 2) << 1));
+  gl_Position = vec4(corner - 1.0, 0.0, 1.0);
+}
+)glsl";
+
+// Pixel for pixel: GL rows are image rows in both textures and in the output.
+constexpr std::string_view kFragmentShader = R"glsl(#version 300 es
+precision highp float;
+uniform highp sampler2D u_virtual_layer;  // linear, premultiplied alpha
+uniform highp sampler2D u_camera;         // the camera's sRGB bytes
+out vec4 out_color;
+
+vec3 decode_srgb(vec3 c) {
+  return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), step(vec3(0.04045), c));
+}
+vec3 encode_srgb(vec3 l) {
+  l = clamp(l, 0.0, 1.0);
+  return mix(l * 12.92, 1.055 * pow(l, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), l));
+}
+
+void main() {
+  ivec2 pixel = ivec2(gl_FragCoord.xy);
+  vec4 virtual_layer = texelFetch(u_virtual_layer, pixel, 0);
+  vec3 camera = decode_srgb(texelFetch(u_camera, pixel, 0).rgb);
+  out_color = vec4(encode_srgb(virtual_layer.rgb + (1.0 - virtual_layer.a) * camera), 1.0);
+}
+)glsl";
+
+double elapsed_ms(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+void pass_through(FrameContext& ctx) {
+  ctx.output = Frame::allocate(PixelFormat::RGB24, ctx.camera.width, ctx.camera.height);
+  ctx.output.meta = ctx.camera.meta;
+  to_rgb24(ctx.camera, ctx.output.data);
+}
+
+}  // namespace
+
+CompositeStage::CompositeStage(std::shared_ptr<RenderSession> session) : session_(std::move(session)) {}
+
+CompositeStage::~CompositeStage() {
+  session_->try_make_current();
+  program_ = GlProgram();
+  empty_vertex_array_.reset();
+  camera_texture_.reset();
+  output_framebuffer_.reset();
+  output_texture_.reset();
+}
+
+void CompositeStage::configure(const Config&) {
+  session_->make_current();
+  if (program_.id() == 0) {
+    program_ = GlProgram("compositing", kVertexShader, kFragmentShader);
+    empty_vertex_array_ = GlVertexArray::create();
+    glUseProgram(program_.id());
+    glUniform1i(program_.uniform("u_virtual_layer"), 0);
+    glUniform1i(program_.uniform("u_camera"), 1);
+  }
+  last_error_.clear();
+}
+
+void CompositeStage::process(FrameContext& ctx) noexcept {
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    if (!ctx.virtual_layer_drawn) {
+      pass_through(ctx);
+      ctx.record_timing(std::string(name()), elapsed_ms(start), "nothing virtual drawn: pass-through");
+      return;
+    }
+    composite(ctx);
+    ctx.record_timing(std::string(name()), elapsed_ms(start));
+    last_error_.clear();
+  } catch (const std::exception& e) {
+    if (last_error_ != e.what()) log::error("composite: {}", e.what());
+    last_error_ = e.what();
+    try {
+      pass_through(ctx);
+    } catch (...) {
+      ctx.output = Frame();
+    }
+    ctx.record_timing(std::string(name()), elapsed_ms(start), fmt::format("error: {}", e.what()));
+  } catch (...) {
+    ctx.record_timing(std::string(name()), elapsed_ms(start), "error: unknown exception");
+  }
+}
+
+void CompositeStage::ensure_targets(int width, int height) {
+  if (width == width_ && height == height_) return;
+  camera_texture_ = GlTexture::create();
+  glBindTexture(GL_TEXTURE_2D, camera_texture_.get());
+  glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGB8, width, height);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  output_texture_ = GlTexture::create();
+  glBindTexture(GL_TEXTURE_2D, output_texture_.get());
+  glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA8, width, height);
+  output_framebuffer_ = GlFramebuffer::create();
+  glBindFramebuffer(GL_FRAMEBUFFER, output_framebuffer_.get());
+  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, output_texture_.get(), 0);
+  check_framebuffer_complete("composite output");
+  check_gl("allocating the composite targets");
+  width_ = width;
+  height_ = height;
+}
+
+void CompositeStage::composite(FrameContext& ctx) {
+  const int width = ctx.camera.width, height = ctx.camera.height;
+  VirtualLayer& layer = session_->layer();
+  const PixelRect rect = session_->drawn_rect;
+  if (layer.width() != width || layer.height() != height)
+    throw RenderError(fmt::format("the virtual layer is {}x{} but the camera frame is {}x{}", layer.width(),
+                                  layer.height(), width, height));
+  if (rect.empty() || rect.x < 0 || rect.y < 0 || rect.right() > width || rect.bottom() > height)
+    throw RenderError("the virtual layer's drawn rectangle lies outside the frame");
+
+  // Everything outside the rectangle is the camera frame unchanged; the rectangle is overwritten.
+  pass_through(ctx);
+  session_->make_current();
+  ensure_targets(width, height);
+
+  glActiveTexture(GL_TEXTURE1);
+  glBindTexture(GL_TEXTURE_2D, camera_texture_.get());
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glPixelStorei(GL_UNPACK_ROW_LENGTH, width);
+  glPixelStorei(GL_UNPACK_SKIP_PIXELS, rect.x);
+  glPixelStorei(GL_UNPACK_SKIP_ROWS, rect.y);
+  glTexSubImage2D(GL_TEXTURE_2D, 0, rect.x, rect.y, rect.width, rect.height, GL_RGB, GL_UNSIGNED_BYTE,
+                  ctx.output.data.data());
+  glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+  glPixelStorei(GL_UNPACK_SKIP_PIXELS, 0);
+  glPixelStorei(GL_UNPACK_SKIP_ROWS, 0);
+  glActiveTexture(GL_TEXTURE0);
+  glBindTexture(GL_TEXTURE_2D, layer.texture());
+
+  glBindFramebuffer(GL_FRAMEBUFFER, output_framebuffer_.get());
+  glViewport(0, 0, width, height);
+  glEnable(GL_SCISSOR_TEST);
+  glScissor(rect.x, rect.y, rect.width, rect.height);
+  glDisable(GL_DEPTH_TEST);
+  glDisable(GL_BLEND);
+  glUseProgram(program_.id());
+  glBindVertexArray(empty_vertex_array_.get());
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glBindVertexArray(0);
+  glDisable(GL_SCISSOR_TEST);
+
+  readback_.resize(size_t(rect.width) * rect.height * 4);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(rect.x, rect.y, rect.width, rect.height, GL_RGBA, GL_UNSIGNED_BYTE, readback_.data());
+  check_gl("compositing");
+  for (int row = 0; row < rect.height; ++row) {
+    const uint8_t* from = readback_.data() + size_t(row) * rect.width * 4;
+    uint8_t* to = ctx.output.data.data() + size_t(rect.y + row) * ctx.output.bytes_per_line + size_t(rect.x) * 3;
+    for (int column = 0; column < rect.width; ++column) {
+      to[3 * column] = from[4 * column];
+      to[3 * column + 1] = from[4 * column + 1];
+      to[3 * column + 2] = from[4 * column + 2];
+    }
+  }
+}
+
+}  // namespace arpipe

@@ -1,0 +1,20 @@
+// Loads the triangle meshes of a glTF 2.0 file (.gltf or .glb, via tinygltf) into one Mesh, with
+// node transforms applied and glTF's y-up axes turned into arpipe's z-up object frame.
+#pragma once
+
+#include <filesystem>
+
+#include "render/mesh.h"
+
+namespace arpipe {
+
+// Walks the default scene (else the first scene, else every root node). Triangle lists, strips and
+// fans are kept; points and lines are skipped. Each primitive becomes one MeshPart coloured by its
+// material's baseColorFactor (white without a material). Normals missing from the file are made
+// flat, as glTF asks. The axes turn so that glTF's +y (up) is the object's +z and glTF's +z (the
+// model's front) is -y; units stay metres.
+// Throws AssetError naming the file and what was wrong: missing or unreadable file, JSON or GLB
+// syntax, a bad accessor (naming the mesh, primitive and attribute), no triangles at all.
+Mesh load_gltf_mesh(const std::filesystem::path& path);
+
+}  // namespace arpipe

@@ -1,0 +1,38 @@
+// A triangle mesh in an object's own frame (metres, z up): what the loaders produce and the GPU
+// upload consumes. Parts share the vertex arrays and differ in base colour.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/geometry/vec.h"
+
+namespace arpipe {
+
+struct MeshPart {
+  uint32_t first_index = 0;  // into Mesh::indices
+  uint32_t index_count = 0;
+  std::array<float, 4> base_color{1, 1, 1, 1};  // linear RGBA, not premultiplied
+};
+
+struct Bounds {
+  Vec3 min{0, 0, 0};
+  Vec3 max{0, 0, 0};
+};
+
+struct Mesh {
+  std::vector<float> positions;  // x, y, z per vertex
+  std::vector<float> normals;    // unit, x, y, z per vertex
+  std::vector<uint32_t> indices; // three per triangle, counter-clockwise seen from outside
+  std::vector<MeshPart> parts;
+
+  size_t vertex_count() const { return positions.size() / 3; }
+  size_t triangle_count() const { return indices.size() / 3; }
+  Bounds bounds() const;  // axis-aligned, of all vertices; zero box for an empty mesh
+  // Sets every part's base colour (builtin meshes take theirs from the config).
+  void set_base_color(const std::array<float, 4>& rgba);
+};
+
+}  // namespace arpipe

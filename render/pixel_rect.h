@@ -1,0 +1,31 @@
+// An axis-aligned rectangle of whole pixels in image coordinates (x right, y down): the region of
+// the frame that the virtual layer covers and to which GL work and readback are restricted.
+#pragma once
+
+#include <algorithm>
+
+namespace arpipe {
+
+struct PixelRect {
+  int x = 0;
+  int y = 0;
+  int width = 0;
+  int height = 0;
+
+  bool empty() const { return width <= 0 || height <= 0; }
+  int right() const { return x + width; }   // one past the last column
+  int bottom() const { return y + height; }  // one past the last row
+  bool contains(int px, int py) const { return px >= x && px < right() && py >= y && py < bottom(); }
+
+  static PixelRect full(int width, int height) { return {0, 0, width, height}; }
+  // Smallest rectangle holding both; an empty one adds nothing.
+  PixelRect united(const PixelRect& other) const {
+    if (empty()) return other;
+    if (other.empty()) return *this;
+    const int left = std::min(x, other.x), top = std::min(y, other.y);
+    return {left, top, std::max(right(), other.right()) - left, std::max(bottom(), other.bottom()) - top};
+  }
+  bool operator==(const PixelRect&) const = default;
+};
+
+}  // namespace arpipe

@@ -1,0 +1,63 @@
+// Where in the image an object can appear: the pixel rectangle that its bounding box projects to
+// through the camera model, used to skip frames with nothing in view and to limit GL work.
+#include "render/projected_bounds.h"
+
+#include <array>
+#include <cmath>
+#include <vector>
+
+#include "render/lens_projection.h"
+
+namespace arpipe {
+namespace {
+
+// The outline of a convex box in the image is the image of some of its edges, and a distorting
+// lens bends edges; points along each edge (not just the corners) follow the bend.
+constexpr int kSamplesPerEdge = 16;
+
+}  // namespace
+
+std::optional<PixelRect> projected_box_rect(const CameraModel& camera, const SE3& T_cam_object, const Bounds& box,
+                                            double margin_px) {
+  std::array<Vec3, 8> corners;
+  int behind = 0;
+  for (int i = 0; i < 8; ++i) {
+    const Vec3 corner{(i & 1) ? box.max[0] : box.min[0], (i & 2) ? box.max[1] : box.min[1],
+                      (i & 4) ? box.max[2] : box.min[2]};
+    corners[static_cast<size_t>(i)] = T_cam_object * corner;
+    if (corners[static_cast<size_t>(i)][2] <= kNearPlaneM) ++behind;
+  }
+  if (behind == 8) return std::nullopt;
+  const PixelRect image = PixelRect::full(camera.width(), camera.height());
+  if (behind > 0) return image;
+
+  std::vector<Vec3> points;
+  points.reserve(12 * (kSamplesPerEdge + 1));
+  for (int a = 0; a < 8; ++a)
+    for (int bit = 1; bit < 8; bit <<= 1) {
+      if (a & bit) continue;  // each edge once, from the corner with the bit clear
+      const Vec3& from = corners[static_cast<size_t>(a)];
+      const Vec3& to = corners[static_cast<size_t>(a | bit)];
+      for (int s = 0; s <= kSamplesPerEdge; ++s) points.push_back(from + (double(s) / kSamplesPerEdge) * (to - from));
+    }
+  std::vector<Vec2> pixels;
+  camera.project(points, pixels);
+
+  double min_u = INFINITY, min_v = INFINITY, max_u = -INFINITY, max_v = -INFINITY;
+  for (const Vec2& pixel : pixels) {
+    if (!std::isfinite(pixel[0]) || !std::isfinite(pixel[1])) return image;  // cannot bound it: be safe
+    min_u = std::min(min_u, pixel[0]);
+    max_u = std::max(max_u, pixel[0]);
+    min_v = std::min(min_v, pixel[1]);
+    max_v = std::max(max_v, pixel[1]);
+  }
+  // Pixel i spans [i - 0.5, i + 0.5] (centres at integers).
+  const double left = std::floor(min_u - margin_px + 0.5), right = std::ceil(max_u + margin_px + 0.5);
+  const double top = std::floor(min_v - margin_px + 0.5), bottom = std::ceil(max_v + margin_px + 0.5);
+  const double x0 = std::max(left, 0.0), y0 = std::max(top, 0.0);
+  const double x1 = std::min(right, double(image.width)), y1 = std::min(bottom, double(image.height));
+  if (x1 <= x0 || y1 <= y0) return std::nullopt;
+  return PixelRect{int(x0), int(y0), int(x1 - x0), int(y1 - y0)};
+}
+
+}  // namespace arpipe

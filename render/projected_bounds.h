@@ -1,0 +1,21 @@
+// Where in the image an object can appear: the pixel rectangle that its bounding box projects to
+// through the camera model, used to skip frames with nothing in view and to limit GL work.
+#pragma once
+
+#include <optional>
+
+#include "core/geometry/camera_model.h"
+#include "core/geometry/se3.h"
+#include "render/mesh.h"
+#include "render/pixel_rect.h"
+
+namespace arpipe {
+
+// box: in the object's frame (already scaled); T_cam_object maps it into the camera frame.
+// Returns the bounding rectangle of the projected box, widened by margin_px and clipped to the
+// image; the whole image when the box reaches behind the near plane (its projection is unbounded);
+// nullopt when it lies wholly behind the near plane or outside the image.
+std::optional<PixelRect> projected_box_rect(const CameraModel& camera, const SE3& T_cam_object, const Bounds& box,
+                                            double margin_px);
+
+}  // namespace arpipe

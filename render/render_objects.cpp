@@ -1,0 +1,77 @@
+// The scene's virtual objects as the render stage draws them: meshes loaded and uploaded once per
+// configure, with their placement on the anchor and their base colours.
+#include "render/render_objects.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <map>
+
+#include "render/builtin_meshes.h"
+#include "render/gltf_loader.h"
+
+namespace arpipe {
+namespace {
+
+constexpr std::string_view kBuiltinPrefix = "builtin:";
+
+Mesh load_mesh(const Config& config, size_t object_index, const std::string& source) {
+  if (source.rfind(kBuiltinPrefix, 0) == 0) {
+    const std::string name = source.substr(kBuiltinPrefix.size());
+    if (name == "cube") return make_cube_mesh();
+    if (name == "pyramid") return make_pyramid_mesh();
+    throw ConfigError(fmt::format("{}: render.objects[{}].mesh: unknown builtin mesh \"{}\" (expected "
+                                  "\"builtin:cube\", \"builtin:pyramid\" or a glTF 2.0 file)",
+                                  config.file.empty() ? std::string("config") : config.file.string(), object_index,
+                                  source));
+  }
+  return load_gltf_mesh(resolve_mesh_path(config, source));
+}
+
+Bounds scaled(const Bounds& box, double scale) {
+  Bounds out;
+  for (size_t axis = 0; axis < 3; ++axis) {
+    const double a = box.min[axis] * scale, b = box.max[axis] * scale;
+    out.min[axis] = std::min(a, b);
+    out.max[axis] = std::max(a, b);
+  }
+  return out;
+}
+
+}  // namespace
+
+std::filesystem::path resolve_mesh_path(const Config& config, const std::string& mesh) {
+  std::filesystem::path path(mesh);
+  if (path.is_absolute() || config.file.empty()) return path;
+  return config.file.parent_path() / path;
+}
+
+std::vector<RenderObject> load_render_objects(const Config& config) {
+  struct Loaded {
+    std::shared_ptr<const GpuMesh> gpu;
+    Bounds bounds;
+  };
+  std::map<std::string, Loaded> loaded;
+  std::vector<RenderObject> objects;
+  for (size_t i = 0; i < config.render.objects.size(); ++i) {
+    const SceneObject& object = config.render.objects[i];
+    auto found = loaded.find(object.mesh);
+    if (found == loaded.end()) {
+      const Mesh mesh = load_mesh(config, i, object.mesh);
+      found = loaded.emplace(object.mesh, Loaded{std::make_shared<const GpuMesh>(mesh), mesh.bounds()}).first;
+    }
+    RenderObject out;
+    out.mesh_source = object.mesh;
+    out.mesh = found->second.gpu;
+    out.scale = object.scale;
+    out.bounds = scaled(found->second.bounds, object.scale);
+    out.T_world_object = SE3::from_rt({0, 0, object.yaw_rad}, object.position_m);
+    if (object.mesh.rfind(kBuiltinPrefix, 0) == 0)
+      out.base_color = std::array<float, 4>{static_cast<float>(object.color[0]), static_cast<float>(object.color[1]),
+                                            static_cast<float>(object.color[2]), 1.0f};
+    objects.push_back(std::move(out));
+  }
+  return objects;
+}
+
+}  // namespace arpipe

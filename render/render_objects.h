@@ -1,0 +1,35 @@
+// The scene's virtual objects as the render stage draws them: meshes loaded and uploaded once per
+// configure, with their placement on the anchor and their base colours.
+#pragma once
+
+#include <array>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/config/config.h"
+#include "core/geometry/se3.h"
+#include "render/gpu_mesh.h"
+#include "render/mesh.h"
+
+namespace arpipe {
+
+struct RenderObject {
+  std::string mesh_source;               // as the config names it, for messages
+  std::shared_ptr<const GpuMesh> mesh;   // shared by objects that name the same mesh
+  Bounds bounds;                         // in the object frame, scaled
+  SE3 T_world_object;                    // placement without the scale
+  double scale = 1.0;
+  std::optional<std::array<float, 4>> base_color;  // set for builtin meshes (config colour); else the file's
+};
+
+// Where a mesh path in the config points: relative paths are taken from the config file's folder
+// (from the working directory when the config has no file).
+std::filesystem::path resolve_mesh_path(const Config& config, const std::string& mesh);
+
+// Loads every render.objects entry; needs a current GL context. Each distinct mesh is read once.
+// Throws ConfigError for an unknown "builtin:" name and AssetError for a missing or bad file.
+std::vector<RenderObject> load_render_objects(const Config& config);
+
+}  // namespace arpipe

@@ -1,0 +1,42 @@
+// What the render and composite stages share: the one EGL context (made by the first configure,
+// on the processing thread) and the virtual layer with the rectangle drawn into it this frame.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "render/egl_context.h"
+#include "render/pixel_rect.h"
+#include "render/virtual_layer.h"
+
+namespace arpipe {
+
+class RenderSession {
+ public:
+  RenderSession() = default;
+  ~RenderSession();
+  RenderSession(const RenderSession&) = delete;
+  RenderSession& operator=(const RenderSession&) = delete;
+
+  // Creates the context and the virtual layer on the first call; throws RenderError when no
+  // context can be made. The platform is fixed from then on: a later different request warns.
+  void ensure_context(const std::string& egl_platform);
+  bool has_context() const { return context_ != nullptr; }
+  // Makes the context current on the calling thread; throws RenderError (also when there is none).
+  void make_current() const;
+  // As make_current, for destructors: reports nothing, returns whether the context is current.
+  bool try_make_current() const noexcept;
+
+  const EglContext& context() const { return *context_; }
+  VirtualLayer& layer() { return *layer_; }
+
+  // The part of the layer drawn for the current frame; meaningful when ctx.virtual_layer_drawn.
+  PixelRect drawn_rect;
+
+ private:
+  std::unique_ptr<EglContext> context_;
+  std::string platform_request_;
+  std::unique_ptr<VirtualLayer> layer_;  // declared after the context: destroyed before it
+};
+
+}  // namespace arpipe

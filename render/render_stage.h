@@ -1,0 +1,46 @@
+// The render stage: draws the scene's virtual objects, seen from the tracked pose through the
+// calibrated lens, into the shared virtual layer (linear, premultiplied alpha, depth-tested).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/pipeline/stage.h"
+#include "render/gl_program.h"
+#include "render/render_objects.h"
+#include "render/render_session.h"
+
+namespace arpipe {
+
+class RenderStage final : public Stage {
+ public:
+  explicit RenderStage(std::shared_ptr<RenderSession> session);
+  ~RenderStage() override;
+
+  std::string_view name() const override { return "render"; }
+  // Creates the GL context on the first call (on this thread), compiles the shaders once, and
+  // loads the meshes; throws RenderError, ConfigError or AssetError and then keeps the old setup.
+  void configure(const Config& config) override;
+  // Skips (ctx.virtual_layer_drawn = false, reason recorded) when rendering is off, there are no
+  // objects, the pose is not Tracking, or no object's box reaches into the image.
+  void process(FrameContext& ctx) noexcept override;
+
+ private:
+  struct Settings {
+    bool enabled = true;
+    int msaa_samples = 4;
+    Vec3 light_direction{0, 0, 1};
+    Vec3 light_color{1, 1, 1};
+    Vec3 ambient{0, 0, 0};
+  };
+  void draw(FrameContext& ctx);
+
+  std::shared_ptr<RenderSession> session_;  // first member: outlives the GL objects below
+  GlProgram program_;
+  std::vector<RenderObject> objects_;
+  Settings settings_;
+  std::string last_error_;  // logged once per distinct message, not once per frame
+};
+
+}  // namespace arpipe

@@ -1,0 +1,46 @@
+// The off-screen image that the render stage draws virtual objects into: linear, premultiplied
+// alpha, at the camera's size, multisampled when asked and resolved into a texture to composite.
+#pragma once
+
+#include "render/egl_context.h"
+#include "render/gl_objects.h"
+#include "render/pixel_rect.h"
+
+namespace arpipe {
+
+class VirtualLayer {
+ public:
+  // Chooses the colour format: GL_RGBA16F where the context can render to half floats, else
+  // GL_SRGB8_ALPHA8 (8 bits but sRGB-encoded, so dark linear values keep their precision).
+  explicit VirtualLayer(const EglContext& context);
+
+  // (Re)allocates when the size or sample count changes; samples <= 1 means no multisampling, and
+  // a count above what the format supports is lowered to that (with a warning).
+  void ensure(int width, int height, int msaa_samples);
+  // Binds the framebuffer to draw into with viewport = whole image, scissor = rect (left enabled),
+  // and clears the rect to transparent black and far depth.
+  void begin(const PixelRect& rect);
+  // Makes what was drawn inside rect available in texture().
+  void resolve(const PixelRect& rect);
+
+  GLuint texture() const { return resolved_texture_.get(); }
+  GLenum color_format() const { return color_format_; }
+  int samples() const { return samples_; }  // 1 when not multisampled
+  int width() const { return width_; }
+  int height() const { return height_; }
+
+ private:
+  GLenum color_format_;
+  int max_samples_ = 1;
+  int width_ = 0;
+  int height_ = 0;
+  int requested_samples_ = -1;
+  int samples_ = 1;
+  GlTexture resolved_texture_;
+  GlFramebuffer resolved_framebuffer_;
+  GlRenderbuffer multisample_color_;
+  GlRenderbuffer depth_;
+  GlFramebuffer draw_framebuffer_;  // the multisampled one, or resolved_framebuffer_'s twin with depth
+};
+
+}  // namespace arpipe

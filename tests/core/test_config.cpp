@@ -1,0 +1,378 @@
+// Config tests: defaults, every kind of error with its file/line/column, overrides from the
+// command line, and the default TOML document reading back as the default Config.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "core/config/config.h"
+
+namespace arpipe {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double kPi = std::numbers::pi;
+
+Config default_config_from(const std::string& source) {
+  Config config;
+  config.file = source;
+  return config;
+}
+
+// Expects a ConfigError whose message contains every fragment.
+void expect_error(const std::string& text, const std::vector<std::string>& fragments,
+                  const std::vector<std::string>& overrides = {}) {
+  try {
+    parse_config(text, "test.toml", overrides);
+    ADD_FAILURE() << "expected a ConfigError for:\n" << text;
+  } catch (const ConfigError& e) {
+    const std::string message = e.what();
+    for (const auto& fragment : fragments)
+      EXPECT_NE(message.find(fragment), std::string::npos) << "'" << fragment << "' missing from: " << message;
+  }
+}
+
+TEST(Config, DefaultsAreTheDocumentedOnes) {
+  const Config c;
+  EXPECT_EQ(c.source.type, "replay");
+  EXPECT_EQ(c.source.pacing, "timestamps");
+  EXPECT_EQ(c.track.family, "tag36h11");
+  ASSERT_EQ(c.track.bundle.size(), 1u);
+  EXPECT_EQ(c.track.bundle[0].id, 0);
+  EXPECT_EQ(c.track.bundle[0].size_m, 0.1);
+  EXPECT_EQ(c.render.msaa_samples, 4);
+  EXPECT_EQ(c.pipeline.queue_depth, 4);
+  EXPECT_EQ(c.pipeline.log_level, "info");
+  // The default light direction is (0.3, -0.4, 1) made unit length.
+  EXPECT_NEAR(norm(c.render.light_direction), 1.0, 1e-15);
+  EXPECT_NEAR(c.render.light_direction[0] / c.render.light_direction[2], 0.3, 1e-15);
+  EXPECT_NEAR(c.render.light_direction[1] / c.render.light_direction[2], -0.4, 1e-15);
+}
+
+TEST(Config, EmptyTextGivesTheDefaults) {
+  EXPECT_EQ(parse_config("", "empty.toml"), default_config_from("empty.toml"));
+  EXPECT_EQ(parse_config("# only a comment\n[track]\n[sinks.png]\n", "c.toml"), default_config_from("c.toml"));
+}
+
+TEST(Config, DefaultTomlReadsBackAsTheDefaultConfigAndListsEveryKey) {
+  const std::string text = default_config_toml();
+  EXPECT_EQ(parse_config(text, "defaults.toml"), default_config_from("defaults.toml"));
+  // Every key of the schema appears with a value, so the document is the full reference.
+  for (const char* line :
+       {"[source]", "type = ", "path = ", "pacing = ", "loop = ", "timestamp_offset_ns = ", "camera_model = ",
+        "[track]", "enabled = ", "family = ", "quad_decimate = ", "quad_sigma = ", "threads = ", "max_hamming = ",
+        "min_decision_margin = ", "ambiguity_ratio = ", "[[track.bundle]]", "id = ", "size_m = ", "center_m = ",
+        "yaw_deg = ", "[render]", "light_direction = ", "light_color = ", "ambient = ", "msaa_samples = ",
+        "egl_platform = ", "[[render.objects]]", "mesh = ", "position_m = ", "scale = ", "color = ", "[sinks.png]",
+        "dir = ", "every = ", "[sinks.y4m]", "[sinks.recording]", "[sinks.results]", "[pipeline]", "queue_depth = ",
+        "max_frames = ", "log_level = "})
+    EXPECT_NE(text.find(std::string("\n") + line), std::string::npos) << line;
+}
+
+TEST(Config, ReadsEveryKey) {
+  const std::string text = R"(
+[source]
+type = "replay"
+path = "rec/one"
+pacing = "fast"
+loop = true
+timestamp_offset_ns = -1500000
+camera_model = "cam.cameramodel"
+
+[track]
+enabled = true
+family = "tagStandard41h12"
+quad_decimate = 1
+quad_sigma = -0.5
+threads = 2
+max_hamming = 2
+min_decision_margin = 35.5
+ambiguity_ratio = 4.0
+
+[[track.bundle]]
+id = 7
+size_m = 0.05
+center_m = [0.1, -0.2, 0.0]
+yaw_deg = 90
+
+[[track.bundle]]
+id = 8
+size_m = 0.08
+center_m = [0.3, 0.0, 0]
+yaw_deg = -45.0
+
+[render]
+enabled = false
+light_direction = [0, 0, 2]
+light_color = [2.0, 1.5, 1.0]
+ambient = [0.1, 0.1, 0.2]
+msaa_samples = 2
+egl_platform = "surfaceless"
+
+[[render.objects]]
+mesh = "builtin:pyramid"
+position_m = [0.0, 0.1, 0.02]
+yaw_deg = 180
+scale = 0.5
+color = [0.2, 0.8, 0.2]
+
+[[render.objects]]
+mesh = "assets/duck.gltf"
+
+[sinks.png]
+enabled = false
+dir = "o/png"
+every = 10
+[sinks.y4m]
+enabled = false
+path = "o/v.y4m"
+[sinks.recording]
+enabled = true
+path = "o/rec"
+[sinks.results]
+enabled = false
+path = "o/r.jsonl"
+
+[pipeline]
+queue_depth = 8
+max_frames = 1000
+log_level = "debug"
+)";
+  const Config c = parse_config(text, "full.toml");
+  EXPECT_EQ(c.file, "full.toml");
+  EXPECT_EQ(c.source.path, "rec/one");
+  EXPECT_EQ(c.source.pacing, "fast");
+  EXPECT_TRUE(c.source.loop);
+  EXPECT_EQ(c.source.timestamp_offset_ns, -1500000);
+  EXPECT_EQ(c.source.camera_model, "cam.cameramodel");
+  EXPECT_EQ(c.track.family, "tagStandard41h12");
+  EXPECT_EQ(c.track.quad_decimate, 1.0);
+  EXPECT_EQ(c.track.quad_sigma, -0.5);
+  EXPECT_EQ(c.track.threads, 2);
+  EXPECT_EQ(c.track.max_hamming, 2);
+  EXPECT_EQ(c.track.min_decision_margin, 35.5);
+  EXPECT_EQ(c.track.ambiguity_ratio, 4.0);
+  ASSERT_EQ(c.track.bundle.size(), 2u);
+  EXPECT_EQ(c.track.bundle[0].id, 7);
+  EXPECT_EQ(c.track.bundle[0].size_m, 0.05);
+  EXPECT_EQ(c.track.bundle[0].center_m, (Vec3{0.1, -0.2, 0.0}));
+  // Degrees at the boundary, radians inside: 90 deg = pi/2 to rounding.
+  EXPECT_NEAR(c.track.bundle[0].yaw_rad, kPi / 2, 1e-15);
+  EXPECT_NEAR(c.track.bundle[1].yaw_rad, -kPi / 4, 1e-15);
+  EXPECT_EQ(c.track.bundle[1].center_m, (Vec3{0.3, 0.0, 0.0}));
+  EXPECT_FALSE(c.render.enabled);
+  EXPECT_EQ(c.render.light_direction, (Vec3{0, 0, 1}));  // normalised
+  EXPECT_EQ(c.render.light_color, (Vec3{2.0, 1.5, 1.0}));
+  EXPECT_EQ(c.render.ambient, (Vec3{0.1, 0.1, 0.2}));
+  EXPECT_EQ(c.render.msaa_samples, 2);
+  EXPECT_EQ(c.render.egl_platform, "surfaceless");
+  ASSERT_EQ(c.render.objects.size(), 2u);
+  EXPECT_EQ(c.render.objects[0].mesh, "builtin:pyramid");
+  EXPECT_EQ(c.render.objects[0].position_m, (Vec3{0.0, 0.1, 0.02}));
+  EXPECT_NEAR(c.render.objects[0].yaw_rad, kPi, 1e-15);
+  EXPECT_EQ(c.render.objects[0].scale, 0.5);
+  EXPECT_EQ(c.render.objects[0].color, (Vec3{0.2, 0.8, 0.2}));
+  EXPECT_EQ(c.render.objects[1], (SceneObject{"assets/duck.gltf"}));  // the rest at defaults
+  EXPECT_FALSE(c.sinks.png.enabled);
+  EXPECT_EQ(c.sinks.png.dir, "o/png");
+  EXPECT_EQ(c.sinks.png.every, 10);
+  EXPECT_EQ(c.sinks.y4m.path, "o/v.y4m");
+  EXPECT_FALSE(c.sinks.y4m.enabled);
+  EXPECT_TRUE(c.sinks.recording.enabled);
+  EXPECT_EQ(c.sinks.recording.path, "o/rec");
+  EXPECT_FALSE(c.sinks.results.enabled);
+  EXPECT_EQ(c.sinks.results.path, "o/r.jsonl");
+  EXPECT_EQ(c.pipeline.queue_depth, 8);
+  EXPECT_EQ(c.pipeline.max_frames, 1000);
+  EXPECT_EQ(c.pipeline.log_level, "debug");
+}
+
+TEST(Config, InlineArrayOfTablesIsTheSameAsArrayOfTables) {
+  const Config a = parse_config("[track]\nbundle = [{id = 3, size_m = 0.2}, {id = 4}]\n", "a.toml");
+  ASSERT_EQ(a.track.bundle.size(), 2u);
+  EXPECT_EQ(a.track.bundle[0].id, 3);
+  EXPECT_EQ(a.track.bundle[0].size_m, 0.2);
+  EXPECT_EQ(a.track.bundle[1].id, 4);
+  EXPECT_EQ(a.track.bundle[1].size_m, 0.1);
+}
+
+TEST(Config, EmptyObjectListMeansNothingVirtual) {
+  EXPECT_TRUE(parse_config("[render]\nobjects = []\n", "e.toml").render.objects.empty());
+}
+
+TEST(Config, UnknownKeysAreErrorsWithPlaceAndAllowedKeys) {
+  expect_error("[track]\nfamily = \"tag36h11\"\nfamliy = \"x\"\n",
+               {"test.toml:3:1:", "unknown key 'track.famliy'", "allowed keys in [track]:", "family", "bundle",
+                "ambiguity_ratio"});
+  expect_error("\n\n[tracking]\nenabled = true\n",
+               {"test.toml:3:", "unknown key 'tracking'", "source, track, render, sinks, pipeline"});
+  expect_error("typo = 1\n", {"test.toml:1:1:", "unknown key 'typo'"});
+  expect_error("[sinks.png]\nenabled = true\nquality = 9\n",
+               {"test.toml:3:1:", "unknown key 'sinks.png.quality'", "allowed keys in [sinks.png]: enabled, dir, every"});
+  expect_error("[sinks.jpeg]\n", {"test.toml:1:", "unknown key 'sinks.jpeg'", "png, y4m, recording, results"});
+  expect_error("[[track.bundle]]\nid = 1\n[[track.bundle]]\nid = 2\nsize = 0.1\n",
+               {"test.toml:5:1:", "unknown key 'track.bundle[1].size'", "id, size_m, center_m, yaw_deg"});
+  expect_error("[[render.objects]]\nyaw = 90\n",
+               {"test.toml:2:1:", "unknown key 'render.objects[0].yaw'", "mesh, position_m, yaw_deg, scale, color"});
+  // Several unknown keys: the first in the file is named.
+  expect_error("[pipeline]\nzzz = 1\naaa = 2\n", {"test.toml:2:1:", "'pipeline.zzz'"});
+}
+
+TEST(Config, WrongTypesSayWhatWasExpected) {
+  expect_error("[pipeline]\nqueue_depth = \"4\"\n",
+               {"test.toml:2:15:", "'pipeline.queue_depth' expected an integer, got a string"});
+  expect_error("[pipeline]\nqueue_depth = 4.0\n", {"test.toml:2:15:", "expected an integer, got a float"});
+  expect_error("[source]\nloop = 1\n", {"test.toml:2:8:", "'source.loop' expected a boolean", "got an integer"});
+  expect_error("[track]\nquad_decimate = \"2\"\n", {"test.toml:2:", "'track.quad_decimate' expected", "got a string"});
+  expect_error("[source]\npath = 3\n", {"test.toml:2:8:", "'source.path' expected a string, got an integer"});
+  expect_error("source = 3\n", {"test.toml:1:", "'source' expected a table, got an integer"});
+  expect_error("[track]\nbundle = 3\n", {"test.toml:2:", "'track.bundle' expected an array of tables, got an integer"});
+  expect_error("[track]\nbundle = [1, 2]\n", {"test.toml:2:", "'track.bundle[0]' expected a table, got an integer"});
+  expect_error("[render]\nambient = [0.1, 0.1]\n",
+               {"test.toml:2:11:", "'render.ambient' expected an array of 3", "got 2 items"});
+  expect_error("[render]\nambient = [0.1, \"x\", 0.1]\n", {"test.toml:2:", "'render.ambient[1]' expected", "got a string"});
+  expect_error("[render]\nambient = 0.1\n", {"test.toml:2:", "'render.ambient' expected an array of 3", "got a float"});
+  expect_error("[[track.bundle]]\nsize_m = nan\n", {"test.toml:2:", "'track.bundle[0].size_m' expected a finite number"});
+  expect_error("[pipeline]\nmax_frames = 2024-01-01\n", {"test.toml:2:", "got a date"});
+}
+
+TEST(Config, OutOfRangeValuesSayWhatWasExpected) {
+  expect_error("[pipeline]\nqueue_depth = 0\n",
+               {"test.toml:2:15:", "'pipeline.queue_depth' expected an integer >= 1, got 0"});
+  expect_error("[pipeline]\nmax_frames = -1\n", {"test.toml:2:", "expected an integer >= 0, got -1"});
+  expect_error("[pipeline]\nlog_level = \"verbose\"\n",
+               {"test.toml:2:13:", "'pipeline.log_level' expected one of \"error\", \"warning\", \"info\", \"debug\"",
+                "got \"verbose\""});
+  expect_error("[render]\nmsaa_samples = 3\n", {"test.toml:2:16:", "expected one of 0, 1, 2, 4, got 3"});
+  expect_error("[render]\nmsaa_samples = 8\n", {"expected one of 0, 1, 2, 4, got 8"});
+  expect_error("[render]\negl_platform = \"x11\"\n", {"'render.egl_platform' expected one of", "got \"x11\""});
+  expect_error("[source]\ntype = \"v4l2\"\n", {"test.toml:2:8:", "'source.type' expected one of \"replay\""});
+  expect_error("[source]\npacing = \"slow\"\n", {"'source.pacing' expected one of \"timestamps\", \"fast\""});
+  expect_error("[track]\nfamily = \"tag36h12\"\n",
+               {"test.toml:2:10:", "'track.family' expected one of", "tagCircle49h12", "tag36h10", "got \"tag36h12\""});
+  expect_error("[track]\nthreads = 0\n", {"'track.threads' expected an integer in [1, 64], got 0"});
+  expect_error("[track]\nmax_hamming = 4\n", {"'track.max_hamming' expected an integer in [0, 3], got 4"});
+  expect_error("[track]\nquad_decimate = 0.5\n", {"'track.quad_decimate' expected a number >= 1, got 0.5"});
+  expect_error("[track]\nambiguity_ratio = 0.9\n", {"'track.ambiguity_ratio' expected a number >= 1"});
+  expect_error("[track]\nmin_decision_margin = -1\n", {"'track.min_decision_margin' expected a number >= 0"});
+  expect_error("[[track.bundle]]\nid = 0\nsize_m = 0\n",
+               {"test.toml:3:10:", "'track.bundle[0].size_m' expected a number > 0, got 0.0"});
+  expect_error("[[track.bundle]]\nid = -1\n", {"'track.bundle[0].id' expected an integer in [0, 586], got -1"});
+  expect_error("[[track.bundle]]\nid = 4\n[[track.bundle]]\nid = 5\n[[track.bundle]]\nid = 4\n",
+               {"test.toml:6:6:", "'track.bundle[2].id' expected an id not used by another tag", "4"});
+  expect_error("[track]\nbundle = []\n", {"test.toml:2:", "'track.bundle' expected at least one tag"});
+  expect_error("[[render.objects]]\nscale = 0\n", {"'render.objects[0].scale' expected a number > 0"});
+  expect_error("[[render.objects]]\ncolor = [1, -0.1, 0]\n", {"'render.objects[0].color[1]' expected", ">= 0"});
+  expect_error("[[render.objects]]\nmesh = \"\"\n", {"'render.objects[0].mesh' expected"});
+  expect_error("[render]\nlight_direction = [0, 0, 0]\n",
+               {"test.toml:2:19:", "'render.light_direction' expected a non-zero direction"});
+  expect_error("[sinks.png]\nevery = 0\n", {"test.toml:2:9:", "'sinks.png.every' expected an integer >= 1, got 0"});
+  expect_error("[track]\nthreads = 5000000000\n", {"'track.threads' expected an integer in [1, 64], got 5000000000"});
+}
+
+TEST(Config, TagIdsMustExistInTheFamily) {
+  // tag16h5 has 30 codes and tag36h11 587 (AprilTag's published family sizes).
+  EXPECT_EQ(parse_config("[track]\nfamily = \"tag16h5\"\n[[track.bundle]]\nid = 29\n", "a").track.bundle[0].id, 29);
+  expect_error("[track]\nfamily = \"tag16h5\"\n[[track.bundle]]\nid = 30\n",
+               {"test.toml:4:6:", "expected an integer in [0, 29], got 30"});
+  EXPECT_EQ(parse_config("[[track.bundle]]\nid = 586\n", "a").track.bundle[0].id, 586);
+  expect_error("[[track.bundle]]\nid = 587\n", {"expected an integer in [0, 586], got 587"});
+}
+
+TEST(Config, SyntaxErrorsNameFileLineAndColumn) {
+  expect_error("[pipeline]\nqueue_depth = = 4\n", {"test.toml:2:", "TOML syntax error"});
+  expect_error("[pipeline\n", {"test.toml:1:", "TOML syntax error"});
+  expect_error("[source]\npath = \"unterminated\n", {"test.toml:2:", "TOML syntax error"});
+  expect_error("a = 1\na = 2\n", {"test.toml:2:", "TOML syntax error"});
+}
+
+TEST(Config, LoadConfigReadsAFileAndNamesItInErrors) {
+  const fs::path dir = fs::path(ARPIPE_BINARY_DIR) / "test_tmp" / "config";
+  fs::create_directories(dir);
+  const fs::path good = dir / "good.toml";
+  std::ofstream(good) << "[pipeline]\nqueue_depth = 2\n";
+  const Config c = load_config(good);
+  EXPECT_EQ(c.file, good);
+  EXPECT_EQ(c.pipeline.queue_depth, 2);
+
+  const fs::path bad = dir / "bad.toml";
+  std::ofstream(bad) << "[pipeline]\n\nqueue_depth = -3\n";
+  try {
+    load_config(bad);
+    ADD_FAILURE() << "expected a ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find(bad.string() + ":3:15:"), std::string::npos) << e.what();
+  }
+  const fs::path missing = dir / "missing.toml";
+  try {
+    load_config(missing);
+    ADD_FAILURE() << "expected a ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find(missing.string()), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("No such file"), std::string::npos) << e.what();
+  }
+  const fs::path syntax = dir / "syntax.toml";
+  std::ofstream(syntax) << "[source]\npath = 'a'\nloop = yes\n";
+  try {
+    load_config(syntax);
+    ADD_FAILURE() << "expected a ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find(syntax.string() + ":3:"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Config, OverridesReplaceKeysBeforeValidation) {
+  const std::string file = "[pipeline]\nqueue_depth = 0\n[[render.objects]]\nscale = 2.0\n[[render.objects]]\n";
+  // queue_depth = 0 is invalid in the file, but the override replaces it before validation.
+  const Config c = parse_config(file, "o.toml",
+                                {"pipeline.queue_depth=3", "track.family = \"tag25h9\"", "source.pacing=fast",
+                                 "render.objects.1.scale=0.25", "render.objects.0.position_m=[1, 2, 3]",
+                                 "sinks.png.dir=out/run1", "render.ambient=[0.5, 0.5, 0.5]"});
+  EXPECT_EQ(c.pipeline.queue_depth, 3);
+  EXPECT_EQ(c.track.family, "tag25h9");
+  EXPECT_EQ(c.source.pacing, "fast");  // a bare word is a string
+  ASSERT_EQ(c.render.objects.size(), 2u);
+  EXPECT_EQ(c.render.objects[0].scale, 2.0);
+  EXPECT_EQ(c.render.objects[0].position_m, (Vec3{1, 2, 3}));
+  EXPECT_EQ(c.render.objects[1].scale, 0.25);
+  EXPECT_EQ(c.sinks.png.dir, "out/run1");
+  EXPECT_EQ(c.render.ambient, (Vec3{0.5, 0.5, 0.5}));
+  // Later overrides win; an inline table replaces the whole table.
+  const Config d = parse_config("[source]\npath = \"a\"\nloop = true\n", "o.toml",
+                                {"pipeline.max_frames=5", "pipeline.max_frames=6", "source={path=\"b\"}"});
+  EXPECT_EQ(d.pipeline.max_frames, 6);
+  EXPECT_EQ(d.source.path, "b");
+  EXPECT_FALSE(d.source.loop);
+  // A whole array of tables from the command line.
+  const Config e = parse_config("", "o.toml", {"track.bundle=[{id=5, size_m=0.2}, {id=6}]"});
+  ASSERT_EQ(e.track.bundle.size(), 2u);
+  EXPECT_EQ(e.track.bundle[0].id, 5);
+  EXPECT_EQ(e.track.bundle[1].id, 6);
+}
+
+TEST(Config, BadOverridesAreErrorsNamingTheOverride) {
+  expect_error("", {"override 'pipeline.queue_depth'", "expected section.key=value"}, {"pipeline.queue_depth"});
+  expect_error("", {"override 'pipeline..x=1'", "not a dotted key"}, {"pipeline..x=1"});
+  expect_error("", {"override '=1'", "not a dotted key"}, {"=1"});
+  expect_error("", {"override 'render.ambient=[1,2'", "not valid TOML"}, {"render.ambient=[1,2"});
+  expect_error("", {"override 'pipeline.queue_depth=0'", "'pipeline.queue_depth' expected an integer >= 1, got 0"},
+               {"pipeline.queue_depth=0"});
+  expect_error("", {"override 'pipeline.queue_depht=2'", "unknown key 'pipeline.queue_depht'", "queue_depth"},
+               {"pipeline.queue_depht=2"});
+  expect_error("", {"override 'pipline.queue_depth=2'", "unknown key 'pipline'"}, {"pipline.queue_depth=2"});
+  expect_error("", {"override 'pipeline.queue_depth=four'", "expected an integer, got a string"},
+               {"pipeline.queue_depth=four"});
+  expect_error("[[render.objects]]\n", {"override 'render.objects.3.scale=1'", "not an index"},
+               {"render.objects.3.scale=1"});
+  expect_error("", {"override 'track.bundle.0.size_m=0.2'", "'track.bundle' is not in the file", "track.bundle=[{"},
+               {"track.bundle.0.size_m=0.2"});
+  expect_error("[source]\npath = \"x\"\n", {"override 'source.path.deeper=1'", "'source.path' is a string, not a table"},
+               {"source.path.deeper=1"});
+}
+
+}  // namespace
+}  // namespace arpipe

@@ -1,0 +1,79 @@
+// Tests of the screen rectangle of an object's box: it holds every projected point of the box,
+// it is the whole image when the box reaches behind the camera, and it is absent when the box is
+// out of view.
+#include "render/projected_bounds.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "render_test_support.h"
+
+namespace arpipe {
+namespace {
+
+using render_test::look_at;
+
+const CameraModel kCamera("LENSMODEL_OPENCV8",
+                          {300.0, 302.0, 158.9, 121.4, 0.35, -0.12, 0.0011, -0.0009, 0.02, 0.62, -0.05, 0.03}, 320, 240);
+const Bounds kBox{{-0.03, -0.03, 0.0}, {0.03, 0.03, 0.06}};
+
+TEST(ProjectedBounds, RectangleHoldsEveryProjectedPointOfTheBox) {
+  const SE3 pose = look_at({0.1, -0.25, 0.2}, {-0.05, 0.0, 0.03});
+  const auto rect = projected_box_rect(kCamera, pose, kBox, 0.0);
+  ASSERT_TRUE(rect.has_value());
+  // A dense grid over the box's surface: each projection lies in the rectangle, whose pixels span
+  // [x - 0.5, x + width - 0.5).
+  double min_u = INFINITY, max_u = -INFINITY;
+  for (int i = 0; i <= 20; ++i)
+    for (int j = 0; j <= 20; ++j)
+      for (int k = 0; k <= 20; ++k) {
+        const Vec3 p{kBox.min[0] + (kBox.max[0] - kBox.min[0]) * i / 20, kBox.min[1] + (kBox.max[1] - kBox.min[1]) * j / 20,
+                     kBox.min[2] + (kBox.max[2] - kBox.min[2]) * k / 20};
+        const auto pixel = kCamera.project(pose * p);
+        ASSERT_TRUE(pixel.has_value());
+        min_u = std::min(min_u, (*pixel)[0]);
+        max_u = std::max(max_u, (*pixel)[0]);
+        EXPECT_GE((*pixel)[0], rect->x - 0.5);
+        EXPECT_LT((*pixel)[0], rect->right() - 0.5);
+        EXPECT_GE((*pixel)[1], rect->y - 0.5);
+        EXPECT_LT((*pixel)[1], rect->bottom() - 0.5);
+      }
+  // And it is tight: no more than a pixel of slack on a side without margin (rounding out to whole pixels).
+  EXPECT_LE(min_u - (rect->x - 0.5), 1.0);
+  EXPECT_LE((rect->right() - 0.5) - max_u, 1.0);
+}
+
+TEST(ProjectedBounds, MarginWidensAndTheImageClips) {
+  const SE3 pose = look_at({0.1, -0.25, 0.2}, {-0.05, 0.0, 0.03});
+  const PixelRect tight = *projected_box_rect(kCamera, pose, kBox, 0.0);
+  const PixelRect wide = *projected_box_rect(kCamera, pose, kBox, 3.0);
+  EXPECT_EQ(wide.x, std::max(0, tight.x - 3));
+  EXPECT_EQ(wide.y, std::max(0, tight.y - 3));
+  EXPECT_EQ(wide.right(), std::min(320, tight.right() + 3));
+  EXPECT_EQ(wide.bottom(), std::min(240, tight.bottom() + 3));
+  // Close up, the box fills more than the image: the rectangle is the image.
+  const PixelRect close = *projected_box_rect(kCamera, look_at({0.0, -0.05, 0.04}, {0.0, 0.0, 0.03}), kBox, 2.0);
+  EXPECT_EQ(close, PixelRect::full(320, 240));
+}
+
+TEST(ProjectedBounds, BoxAcrossTheNearPlaneGivesTheWholeImage) {
+  // The camera inside the box, and a camera whose image plane cuts through the box beside it:
+  // part of the box is behind the camera, where no projection bounds it, so the answer must be
+  // the whole image (the safe side).
+  EXPECT_EQ(projected_box_rect(kCamera, look_at({0.0, 0.0, 0.03}, {1.0, 0.0, 0.03}), kBox, 2.0),
+            PixelRect::full(320, 240));
+  EXPECT_EQ(projected_box_rect(kCamera, look_at({0.0, -0.5, 0.03}, {1.0, -0.5, 0.03}), kBox, 2.0),
+            PixelRect::full(320, 240));
+}
+
+TEST(ProjectedBounds, BoxBehindOrBesideTheViewIsAbsent) {
+  // Looking straight away from the box.
+  EXPECT_FALSE(projected_box_rect(kCamera, look_at({0.0, -0.3, 0.03}, {0.0, -1.0, 0.03}), kBox, 2.0).has_value());
+  // In front of the camera but 79 degrees off its axis, far outside the 56-degree field of view.
+  const CameraModel pinhole = CameraModel::pinhole(300, 300, 159.5, 119.5, 320, 240);
+  EXPECT_FALSE(projected_box_rect(pinhole, look_at({0.0, -0.5, 0.03}, {1.0, -0.3, 0.03}), kBox, 2.0).has_value());
+}
+
+}  // namespace
+}  // namespace arpipe
