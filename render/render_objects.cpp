@@ -25,7 +25,7 @@ Mesh load_mesh(const Config& config, size_t object_index, const std::string& sou
                                   config.file.empty() ? std::string("config") : config.file.string(), object_index,
                                   source));
   }
-  return load_gltf_mesh(resolve_mesh_path(config, source));
+  return load_gltf_mesh(source);  // relative to the working directory, like every path in a config
 }
 
 Bounds scaled(const Bounds& box, double scale) {
@@ -39,12 +39,6 @@ Bounds scaled(const Bounds& box, double scale) {
 }
 
 }  // namespace
-
-std::filesystem::path resolve_mesh_path(const Config& config, const std::string& mesh) {
-  std::filesystem::path path(mesh);
-  if (path.is_absolute() || config.file.empty()) return path;
-  return config.file.parent_path() / path;
-}
 
 std::vector<RenderObject> load_render_objects(const Config& config) {
   struct Loaded {

@@ -24,9 +24,6 @@ struct RenderObject {
   std::optional<std::array<float, 4>> base_color;  // set for builtin meshes (config colour); else the file's
 };
 
-// Where a mesh path in the config points: relative paths are taken from the config file's folder
-// (from the working directory when the config has no file).
-std::filesystem::path resolve_mesh_path(const Config& config, const std::string& mesh);
 
 // Loads every render.objects entry; needs a current GL context. Each distinct mesh is read once.
 // Throws ConfigError for an unknown "builtin:" name and AssetError for a missing or bad file.

@@ -8,6 +8,7 @@
 #include "capture/sinks/results_sink.h"
 #include "capture/sinks/y4m_sink.h"
 #include "core/track/tag_tracker.h"
+#include "render/lens_projection.h"
 #include "render/render_stages.h"
 
 namespace arpipe {
@@ -39,6 +40,14 @@ StageFactory make_stage_factory() {
 
 std::unique_ptr<PipelineRunner> assemble_pipeline(const Config& config) {
   auto source = make_source(config);
+  // A lens the renderer cannot reproduce is a setup error, refused before streaming starts.
+  if (config.render.enabled && !config.render.objects.empty() && source->camera_model()) {
+    try {
+      check_lens_model_supported(*source->camera_model());
+    } catch (const std::exception& e) {
+      throw ConfigError(fmt::format("{}: camera model: {}", source->describe(), e.what()));
+    }
+  }
   auto sinks = make_sinks(config);
   return std::make_unique<PipelineRunner>(std::move(source), make_stage_factory(), std::move(sinks), config);
 }

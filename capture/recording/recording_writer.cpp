@@ -61,6 +61,7 @@ struct RecordingWriter::Impl {
   uint64_t frames_end = 0;  // committed lengths: a failed append is cut back to these
   uint64_t metadata_end = 0;
   uint64_t ground_truth_end = 0;
+  bool unflushed = true;
 
   void write_info() {
     const fs::path final_path = dir / kRecordingInfoFile;
@@ -166,10 +167,12 @@ void RecordingWriter::append(const Frame& frame, const std::optional<GroundTruth
   w.metadata_end += line.size();
   w.ground_truth_end += truth_line.size();
   ++w.frames_written;
+  w.unflushed = true;
 }
 
 void RecordingWriter::flush() {
   Impl& w = *impl_;
+  if (!w.unflushed) return;
   try {
     w.frames.sync();
     if (w.ground_truth.is_open()) w.ground_truth.sync();
@@ -178,6 +181,7 @@ void RecordingWriter::flush() {
   } catch (const std::exception& e) {
     throw RecordingError(fmt::format("{}: cannot flush: {}", w.dir.string(), e.what()));
   }
+  w.unflushed = false;
 }
 
 uint64_t RecordingWriter::frames_written() const { return impl_->frames_written; }

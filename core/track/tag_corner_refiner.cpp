@@ -19,6 +19,7 @@ constexpr int kMaxPointsPerEdge = 24;
 constexpr int kMinPointsPerEdge = 4;
 constexpr double kMinContrast = 0.04;        // linear units: black and white must differ this much
 constexpr double kMaxCornerShiftPx = 1.5;    // a refinement that moves a corner farther is refused
+constexpr double kOutlierFactor = 4.0;       // edge points farther than this times the median are dropped
 constexpr int kMaxProfileSamples = 2 * static_cast<int>(kMaxReachPx / kSampleStepPx) + 1;
 
 double srgb_to_linear(double encoded) {
@@ -31,7 +32,7 @@ struct Line {
 };
 
 // Total-least-squares fit (the principal direction of the points).
-std::optional<Line> fit_line(const std::vector<Vec2>& points) {
+std::optional<Line> fit_line_once(const std::vector<Vec2>& points) {
   if (points.size() < static_cast<size_t>(kMinPointsPerEdge)) return std::nullopt;
   double mx = 0, my = 0;
   for (const Vec2& p : points) mx += p[0], my += p[1];
@@ -46,6 +47,23 @@ std::optional<Line> fit_line(const std::vector<Vec2>& points) {
   const double theta = 0.5 * std::atan2(2 * sxy, sxx - syy);
   const double nx = -std::sin(theta), ny = std::cos(theta);
   return Line{nx, ny, nx * mx + ny * my};
+}
+
+// A fit, then a refit without the points far from it (a finger or a glint across an edge).
+std::optional<Line> fit_line(const std::vector<Vec2>& points) {
+  const auto first = fit_line_once(points);
+  if (!first) return std::nullopt;
+  std::vector<double> residuals;
+  for (const Vec2& p : points) residuals.push_back(std::abs(first->nx * p[0] + first->ny * p[1] - first->offset));
+  std::vector<double> sorted = residuals;
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
+  const double limit = kOutlierFactor * sorted[sorted.size() / 2];
+  std::vector<Vec2> inliers;
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (residuals[i] <= limit) inliers.push_back(points[i]);
+  }
+  if (inliers.size() == points.size() || inliers.size() < static_cast<size_t>(kMinPointsPerEdge)) return first;
+  return fit_line_once(inliers);
 }
 
 std::optional<Vec2> intersect(const Line& a, const Line& b) {

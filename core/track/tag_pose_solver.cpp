@@ -13,9 +13,10 @@
 namespace arpipe {
 namespace {
 
-// Two refined seeds closer than this landed in the same minimum (LM converges far tighter).
-constexpr double kSameMinimumRotationRad = 1e-6;
-constexpr double kSameMinimumRelativeTranslation = 1e-6;
+// Two refined seeds closer than this landed in the same minimum: LM converges far tighter, and
+// genuinely distinct minima this close would make the same picture anyway.
+constexpr double kSameMinimumRotationRad = 1e-4;
+constexpr double kSameMinimumRelativeTranslation = 1e-4;
 
 struct UndistortedTag {
   const TagCorrespondence* tag = nullptr;

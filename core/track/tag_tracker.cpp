@@ -2,6 +2,8 @@
 // World frame = anchor: x along the tag's right edge, y along its top edge, z out of its face.
 #include "core/track/tag_tracker.h"
 
+#include <fmt/format.h>
+
 #include <chrono>
 #include <cmath>
 #include <optional>
@@ -72,9 +74,12 @@ struct TagTracker::Impl {
   std::vector<uint8_t> grey;
   std::vector<TagObservation> detections;
   std::vector<TagCorrespondence> correspondences;
+  std::vector<double> correspondence_margins;
+  std::unordered_map<int, size_t> correspondence_by_id;
 
   std::optional<SE3> previous_pose;  // set only while the previous frame was tracked
   bool warned_size_mismatch = false;
+  bool nothing_virtual = false;
 
   void track(FrameContext& ctx);
   // Returns a skip reason, or empty when the frame can be tracked.
@@ -92,6 +97,9 @@ void TagTracker::configure(const Config& config) {
   for (const BundleTag& tag : config.track.bundle) world_corners_by_id[tag.id] = bundle_tag_world_corners(tag);
 
   impl_->config = config.track;
+  // Only the virtual objects need the pose today (light probes and shadows will too): with nothing
+  // to draw, tracking is work the scene does not need.
+  impl_->nothing_virtual = !config.render.enabled || config.render.objects.empty();
   impl_->detector = std::move(detector);
   impl_->world_corners_by_id = std::move(world_corners_by_id);
   // A new bundle may define a different world frame, so the old pose says nothing.
@@ -102,6 +110,7 @@ void TagTracker::configure(const Config& config) {
 std::string TagTracker::Impl::why_not_trackable(const FrameContext& ctx) {
   if (!detector) return "not configured";
   if (!config.enabled) return "disabled";
+  if (nothing_virtual) return "nothing virtual in the scene";
   if (!ctx.camera_model) return "no camera model";
   if (ctx.camera.empty()) return "empty frame";
   if (ctx.camera_model->width() != ctx.camera.width || ctx.camera_model->height() != ctx.camera.height) {
@@ -130,8 +139,8 @@ void TagTracker::Impl::track(FrameContext& ctx) {
 
   // One correspondence per bundle id; if a tag shows up twice (a reflection), the surer one counts.
   correspondences.clear();
-  std::vector<double> margins;
-  std::unordered_map<int, size_t> slot_by_id;
+  correspondence_margins.clear();
+  correspondence_by_id.clear();
   for (TagObservation& observation : detections) {
     const auto world = world_corners_by_id.find(observation.id);
     const bool usable = world != world_corners_by_id.end() && observation.hamming <= config.max_hamming &&
@@ -144,13 +153,13 @@ void TagTracker::Impl::track(FrameContext& ctx) {
     }
     ctx.pose.tags.push_back(observation);
     if (!usable) continue;
-    const auto [slot, inserted] = slot_by_id.emplace(observation.id, correspondences.size());
+    const auto [slot, inserted] = correspondence_by_id.emplace(observation.id, correspondences.size());
     if (inserted) {
       correspondences.push_back({world->second, observation.corners});
-      margins.push_back(observation.decision_margin);
-    } else if (observation.decision_margin > margins[slot->second]) {
+      correspondence_margins.push_back(observation.decision_margin);
+    } else if (observation.decision_margin > correspondence_margins[slot->second]) {
       correspondences[slot->second].pixels = observation.corners;
-      margins[slot->second] = observation.decision_margin;
+      correspondence_margins[slot->second] = observation.decision_margin;
     }
   }
 

@@ -133,9 +133,9 @@ TEST_F(DamagedRecording, CutAtAnyByteOfTheAppendStream) {
   size_t total = 0;
   for (const auto& p : stream) total += p.size;
 
-  // Every 23rd byte, and the bytes around the end of every piece (where lines lose their newline).
+  // Every 37th byte, and the bytes around the end of every piece (where lines lose their newline).
   std::vector<size_t> cuts;
-  for (size_t cut = 0; cut <= total; cut += 23) cuts.push_back(cut);
+  for (size_t cut = 0; cut <= total; cut += 37) cuts.push_back(cut);
   std::vector<size_t> frame_ends{0};
   size_t end = 0;
   for (size_t k = 0; k < stream.size(); ++k) {

@@ -44,7 +44,7 @@ struct Luma {
 // One recording shared by the tests: 8 frames half a second apart (so the poses differ widely),
 // the last two looking away from the tag.
 class TagCapture : public ::testing::Test {
- protected:
+ public:
   static void SetUpTestSuite() {
     options_.frames = 8;
     options_.fps = 2.0;
@@ -78,8 +78,7 @@ class TagCapture : public ::testing::Test {
 // of the printed tag; the world y axis points to the tag's top.
 constexpr double kCornerSigns[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
 
-TEST_F(TagCapture, RecordingDescribesItself) {
-  RecordingReader reader(dir_);
+void expect_documented_metadata(const RecordingReader& reader) {
   EXPECT_TRUE(reader.warnings().empty());
   EXPECT_EQ(reader.info().pixel_format, PixelFormat::YUYV);
   EXPECT_EQ(reader.info().width, 640);
@@ -101,17 +100,16 @@ TEST_F(TagCapture, RecordingDescribesItself) {
 // The true pose puts the projected tag exactly where the renderer drew it: just inside each
 // black-border corner it is dark, on the white border light, and just outside the printed
 // square (the table) light. A quarter cell is 3-4 px here, far more than the 0.5 px rounding.
-TEST_F(TagCapture, GroundTruthCornersLandOnTheRenderedBorders) {
-  RecordingReader reader(dir_);
+void expect_borders_at_the_true_corners(const RecordingReader& reader) {
   const CameraModel& model = reader.camera_model();
   const double cell = 1.0 / 8;  // tag36h11: the black-border edge spans 8 cells
   for (size_t i = 0; i < 6; ++i) {
-    const Luma image = luma(reader, i);
+    const Luma image = TagCapture::luma(reader, i);
     const SE3& pose = reader.ground_truth()[i].T_cam_world_mid;
     for (const auto& sign : kCornerSigns) {
       auto at = [&](double offset) {
         const double d = 0.5 + offset;  // distance from the centre along each axis, tag-size units
-        return image.at(project(model, pose, sign[0] * d, sign[1] * d));
+        return image.at(TagCapture::project(model, pose, sign[0] * d, sign[1] * d));
       };
       EXPECT_LT(at(-cell / 4), kDarkBelow) << "frame " << i << " corner " << sign[0] << "," << sign[1];
       EXPECT_GT(at(cell / 2), kPaperAbove) << "frame " << i << " white border";
@@ -123,17 +121,17 @@ TEST_F(TagCapture, GroundTruthCornersLandOnTheRenderedBorders) {
 
 // Every data cell's centre shows the bit that libapriltag's own image of the tag has there: the
 // texture is neither mirrored nor rotated.
-TEST_F(TagCapture, DataCellsMatchTheFamilyImage) {
+void expect_data_cells_of_the_family_image(const RecordingReader& reader) {
   apriltag_family_t* family = tag36h11_create();
   image_u8_t* tag = apriltag_to_image(family, 0);
-  RecordingReader reader(dir_);
   for (size_t i = 0; i < 6; i += 5) {
-    const Luma image = luma(reader, i);
+    const Luma image = TagCapture::luma(reader, i);
     for (int row = 0; row < tag->height; ++row)
       for (int col = 0; col < tag->width; ++col) {
         // Cell centres in tag-size units; the printed square is 10 cells of 1/8, row 0 at the top (+y).
         const double x = (col + 0.5 - tag->width / 2.0) / 8, y = (tag->height / 2.0 - row - 0.5) / 8;
-        const int value = image.at(project(reader.camera_model(), reader.ground_truth()[i].T_cam_world_mid, x, y));
+        const int value =
+            image.at(TagCapture::project(reader.camera_model(), reader.ground_truth()[i].T_cam_world_mid, x, y));
         if (tag->buf[row * tag->stride + col] > 127)
           EXPECT_GT(value, kLightAbove) << "frame " << i << " cell " << row << "," << col;
         else
@@ -142,6 +140,24 @@ TEST_F(TagCapture, DataCellsMatchTheFamilyImage) {
   }
   image_u8_destroy(tag);
   tag36h11_destroy(family);
+}
+
+// One test for the three render checks, so that ctest (one process per test) renders the shared
+// recording once for them.
+TEST_F(TagCapture, RenderedFramesMatchTheirGroundTruth) {
+  RecordingReader reader(dir_);
+  {
+    SCOPED_TRACE("metadata");
+    expect_documented_metadata(reader);
+  }
+  {
+    SCOPED_TRACE("borders at the true corners");
+    expect_borders_at_the_true_corners(reader);
+  }
+  {
+    SCOPED_TRACE("data cells");
+    expect_data_cells_of_the_family_image(reader);
+  }
 }
 
 // libapriltag, an independent detector, finds tag 0 with its corners on the true projections.

@@ -2,10 +2,13 @@
 // by ray casting through the camera model, and an independent sRGB reference.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <memory>
+#include <numbers>
 #include <optional>
+#include <string_view>
 #include <vector>
 
 #include "core/frame.h"
@@ -113,7 +116,7 @@ inline PixelClass classify_pixel(const CameraModel& camera, const SE3& T_cam_wor
     return PixelClass::Inside;
   }
   for (int k = 0; k < 16; ++k) {
-    const double angle = 2 * M_PI * k / 16;
+    const double angle = 2 * std::numbers::pi * k / 16;
     if (ray_hits_box(camera, T_cam_world, box, {x + band * std::cos(angle), y + band * std::sin(angle)}))
       return PixelClass::Edge;
   }

@@ -119,8 +119,31 @@ TEST(TagCornerRefiner, PutsCornersOnTheTrueEdgesWithinAFewHundredthsOfAPixel) {
                                corners));
     // Noise-free, exact renders: what is left is bilinear interpolation of the area-sampled edge
     // profile, a few hundredths of a pixel.
-    for (size_t k = 0; k < 4; ++k) EXPECT_LT(distance(corners[k], tag.corners[k]), 0.05) << "corner " << k << " cell " << placement.cell_px;
+    for (size_t k = 0; k < 4; ++k) EXPECT_LT(distance(corners[k], tag.corners[k]), 0.05) << "corner " << k;
   }
+}
+
+TEST(TagCornerRefiner, IgnoresASmudgeOnPartOfAnEdge) {
+  const TagCornerRefiner refiner(PixelFormat::GREY);
+  const CameraModel camera = CameraModel::pinhole(300, 300, 159.5, 119.5, 320, 240);
+  RenderedTag tag = render_tag36h11({160.3, 119.6}, 12.0, 0.2);
+  // A dark smudge (3 px radius) on the white paper just outside the right edge (BR to TR), a third
+  // of the way along: the profiles across it see a second dark band and misplace the edge.
+  const Vec2 along{tag.corners[2][0] - tag.corners[1][0], tag.corners[2][1] - tag.corners[1][1]};
+  const double length = norm(along);
+  const Vec2 outward{along[1] / length, -along[0] / length};
+  const Vec2 smudge{tag.corners[1][0] + along[0] / 3 + 2.5 * outward[0], tag.corners[1][1] + along[1] / 3 + 2.5 * outward[1]};
+  for (int y = 0; y < tag.height; ++y) {
+    for (int x = 0; x < tag.width; ++x) {
+      if (std::hypot(x - smudge[0], y - smudge[1]) < 3) tag.pixels[static_cast<size_t>(y) * tag.stride + x] = 90;
+    }
+  }
+  // Start from corners 0.3 px off, as libapriltag's are.
+  std::array<Vec2, 4> corners = tag.corners;
+  for (auto& corner : corners) corner = {corner[0] + 0.2, corner[1] - 0.22};
+  ASSERT_TRUE(refiner.refine(tag.pixels.data(), tag.width, tag.height, tag.stride, camera, 8, corners));
+  // The disturbed points are dropped from the edge's line fit; what is left is as clean as above.
+  for (size_t k = 0; k < 4; ++k) EXPECT_LT(distance(corners[k], tag.corners[k]), 0.05) << "corner " << k;
 }
 
 TEST(TagCornerRefiner, LeavesTagsTooSmallToRefineAlone) {

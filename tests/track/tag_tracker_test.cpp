@@ -107,6 +107,22 @@ TEST(TagTrackerStates, DisabledSkipsWithReasonDisabled) {
   EXPECT_EQ(ctx.timings[0].skipped, "disabled");
 }
 
+// "Skip what a scene doesn't need": with no virtual object (or rendering off) nothing uses the pose.
+TEST(TagTrackerStates, NothingVirtualSkipsTracking) {
+  for (bool render_enabled : {true, false}) {
+    Config config;
+    config.render.enabled = render_enabled;
+    if (render_enabled) config.render.objects.clear();
+    TagTracker tracker;
+    tracker.configure(config);
+    FrameContext ctx = blank_frame_context(320, 240);
+    tracker.process(ctx);
+    EXPECT_EQ(ctx.pose.state, TrackState::NotRun);
+    ASSERT_EQ(ctx.timings.size(), 1u);
+    EXPECT_EQ(ctx.timings[0].skipped, "nothing virtual in the scene");
+  }
+}
+
 TEST(TagTrackerStates, MissingOrMismatchedCameraModelSkipsWithoutThrowing) {
   TagTracker tracker;
   tracker.configure(Config{});
@@ -145,11 +161,13 @@ class ScratchCapture {
   fs::path dir_;
 };
 
-TagCaptureOptions first_frame_only(PixelFormat format) {
+TagCaptureOptions first_frame_only(PixelFormat format, int width = 640, int height = 480) {
   TagCaptureOptions options;
   options.frames = 1;
   options.look_away_frames = 0;
   options.pixel_format = format;
+  options.width = width;
+  options.height = height;
   return options;
 }
 
@@ -181,11 +199,11 @@ bool tag_entirely_out_of_view(const CameraModel& camera, const SE3& T_cam_world,
   return true;
 }
 
-// A generated capture (camera orbiting 0.39-0.57 m over a 10 cm tag36h11, 640x480, OPENCV4 lens,
-// YUYV, sensor noise, its last frames looking away) replayed through the stage frame by frame.
+// A generated capture (the first 0.8 s of the generator's orbit, 0.39-0.57 m over a 10 cm tag36h11;
+// 640x480, OPENCV4 lens, YUYV, sensor noise; its last 3 frames look away) through the stage.
 TEST(GeneratedCapture, PoseMatchesGroundTruthAndTheAnchorLandsWithinOnePixel) {
   TagCaptureOptions options;
-  options.frames = 36;
+  options.frames = 24;
   options.look_away_frames = 3;
   const ScratchCapture capture("orbit", options);
   const RecordingReader reader(capture.dir());
@@ -237,7 +255,7 @@ TEST(GeneratedCapture, PoseMatchesGroundTruthAndTheAnchorLandsWithinOnePixel) {
     }
   }
   // The capture holds both kinds of frame, or this test would prove little.
-  EXPECT_GE(tracked, 30);
+  EXPECT_GE(tracked, 20);
   EXPECT_GE(lost, 3);
 }
 
@@ -246,7 +264,7 @@ TEST(GeneratedCapture, PoseMatchesGroundTruthAndTheAnchorLandsWithinOnePixel) {
 TEST(GeneratedCapture, GreyWithAnyStrideAndNv12TrackLikeTheTruth) {
   for (const PixelFormat format : {PixelFormat::GREY, PixelFormat::NV12}) {
     const ScratchCapture capture(std::string("format-") + std::string(pixel_format_name(format)),
-                                 first_frame_only(format));
+                                 first_frame_only(format, 320, 240));
     const RecordingReader reader(capture.dir());
     const auto camera = std::make_shared<CameraModel>(reader.camera_model());
     const SE3& T_true = reader.ground_truth().at(0).T_cam_world_mid;
@@ -257,9 +275,10 @@ TEST(GeneratedCapture, GreyWithAnyStrideAndNv12TrackLikeTheTruth) {
     ctx.camera_model = camera;
     tracker.process(ctx);
     ASSERT_EQ(ctx.pose.state, TrackState::Tracking) << pixel_format_name(format);
-    // The same bounds as the YUYV orbit above.
-    EXPECT_LT(norm(ctx.pose.T_cam_world.translation() - T_true.translation()), 1e-3) << pixel_format_name(format);
-    EXPECT_LT(rotation_angle_between(ctx.pose.T_cam_world, T_true), 0.5 * kDeg) << pixel_format_name(format);
+    // Half the orbit test's resolution (a quarter of the pixels, to keep the test fast): twice its
+    // bounds, as the corner noise in metres doubles.
+    EXPECT_LT(norm(ctx.pose.T_cam_world.translation() - T_true.translation()), 2e-3) << pixel_format_name(format);
+    EXPECT_LT(rotation_angle_between(ctx.pose.T_cam_world, T_true), 1.0 * kDeg) << pixel_format_name(format);
 
     if (format != PixelFormat::GREY) continue;
     FrameContext padded;
@@ -282,7 +301,7 @@ TEST(GeneratedCapture, GreyWithAnyStrideAndNv12TrackLikeTheTruth) {
 }
 
 TEST(GeneratedCapture, TagsOutsideTheBundleAreListedButNotUsed) {
-  const ScratchCapture capture("other-id", first_frame_only(PixelFormat::YUYV));
+  const ScratchCapture capture("other-id", first_frame_only(PixelFormat::YUYV, 320, 240));
   const RecordingReader reader(capture.dir());
   const auto camera = std::make_shared<CameraModel>(reader.camera_model());
   Config config;
@@ -299,7 +318,7 @@ TEST(GeneratedCapture, TagsOutsideTheBundleAreListedButNotUsed) {
 }
 
 TEST(GeneratedCapture, ARefusedReconfigureKeepsTheRunningConfig) {
-  const ScratchCapture capture("reconfigure", first_frame_only(PixelFormat::YUYV));
+  const ScratchCapture capture("reconfigure", first_frame_only(PixelFormat::YUYV, 320, 240));
   const RecordingReader reader(capture.dir());
   const auto camera = std::make_shared<CameraModel>(reader.camera_model());
   TagTracker tracker;
