@@ -36,6 +36,7 @@ struct ReplaySource::Impl {
   bool interrupted = false;
 
   explicit Impl(const SourceConfig& c) : config(c), reader(c.path) {}
+  SourceStatus next(Frame& frame);
 };
 
 ReplaySource::ReplaySource(const SourceConfig& config) : impl_(std::make_unique<Impl>(config)) {
@@ -89,8 +90,8 @@ void ReplaySource::interrupt() {
   impl_->wake.notify_all();
 }
 
-SourceStatus ReplaySource::next(Frame& frame) {
-  Impl& s = *impl_;
+SourceStatus ReplaySource::Impl::next(Frame& frame) {
+  Impl& s = *this;
   const size_t count = s.reader.frame_count();
   if (count == 0) return SourceStatus::EndOfStream;
   if (s.next_index == count) {
@@ -129,6 +130,15 @@ SourceStatus ReplaySource::next(Frame& frame) {
   frame.meta.timestamp_offset_ns += s.config.timestamp_offset_ns;
   frame.meta.sequence += s.passes * s.loop_sequences;
   return SourceStatus::Frame;
+}
+
+SourceStatus ReplaySource::next(Frame& frame) {
+  try {
+    return impl_->next(frame);
+  } catch (const std::exception& e) {  // per-frame code never throws (DESIGN.md "Errors")
+    log::error("replay {}: {}", impl_->config.path.string(), e.what());
+    return SourceStatus::Retry;
+  }
 }
 
 }  // namespace arpipe

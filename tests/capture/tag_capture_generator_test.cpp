@@ -99,7 +99,8 @@ void expect_documented_metadata(const RecordingReader& reader) {
 
 // The true pose puts the projected tag exactly where the renderer drew it: just inside each
 // black-border corner it is dark, on the white border light, and just outside the printed
-// square (the table) light. A quarter cell is 3-4 px here, far more than the 0.5 px rounding.
+// square (the table) light. A quarter cell is 2-4 px here (foreshortened by the tilt), more than
+// the 0.5 px rounding to a pixel plus the 1 px of anti-aliasing.
 void expect_borders_at_the_true_corners(const RecordingReader& reader) {
   const CameraModel& model = reader.camera_model();
   const double cell = 1.0 / 8;  // tag36h11: the black-border edge spans 8 cells
