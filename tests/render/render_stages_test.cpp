@@ -350,7 +350,7 @@ TEST(RenderStages, GltfObjectRendersWithItsMaterialColourWhereTheConfigPlacesIt)
 
   Config config = cube_config(4);
   config.file = dir / "scene.toml";
-  config.render.objects[0].mesh = "meshes/triangle.gltf";  // relative to the config file
+  config.render.objects[0].mesh = (dir / "meshes" / "triangle.gltf").string();
   config.render.objects[0].scale = 1.5;
   config.render.objects[0].yaw_rad = 0.3;
   config.render.objects[0].position_m = {0.02, 0.01, 0.0};
@@ -390,14 +390,14 @@ TEST(RenderStages, GltfObjectRendersWithItsMaterialColourWhereTheConfigPlacesIt)
 }
 
 TEST(RenderStages, MissingMeshFileFailsConfigureNamingTheFile) {
+  harness().configure(cube_config(4));  // the configuration that must survive the refused one
   Config config = cube_config(4);
   config.file = std::filesystem::path(ARPIPE_BINARY_DIR) / "test_tmp" / "configs" / "scene.toml";
-  config.render.objects[0].mesh = "meshes/missing.gltf";
+  config.render.objects[0].mesh = (config.file.parent_path() / "meshes" / "missing.gltf").string();
   try {
     harness().configure(config);
     FAIL() << "expected AssetError";
   } catch (const AssetError& e) {
-    // Relative mesh paths are taken from the config file's folder.
     const std::string expected_path = (config.file.parent_path() / "meshes" / "missing.gltf").string();
     EXPECT_NE(std::string(e.what()).find(expected_path), std::string::npos) << e.what();
   }
