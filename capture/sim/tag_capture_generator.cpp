@@ -3,15 +3,6 @@
 #include "capture/sim/tag_capture_generator.h"
 
 #include <apriltag/apriltag.h>
-#include <apriltag/tag16h5.h>
-#include <apriltag/tag25h9.h>
-#include <apriltag/tag36h10.h>
-#include <apriltag/tag36h11.h>
-#include <apriltag/tagCircle21h7.h>
-#include <apriltag/tagCircle49h12.h>
-#include <apriltag/tagCustom48h12.h>
-#include <apriltag/tagStandard41h12.h>
-#include <apriltag/tagStandard52h13.h>
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -23,6 +14,7 @@
 
 #include "capture/recording/recording_writer.h"
 #include "core/image/pixel_convert.h"
+#include "core/track/tag_family.h"
 
 namespace arpipe {
 
@@ -41,31 +33,6 @@ constexpr Rgb kPaper{0.80f, 0.80f, 0.78f};
 constexpr Rgb kInk{0.025f, 0.025f, 0.03f};
 constexpr Rgb kTable{0.42f, 0.41f, 0.38f};
 constexpr Rgb kWall{0.30f, 0.32f, 0.36f};  // rays that miss the table (above the horizon)
-
-struct FamilyEntry {
-  const char* name;
-  apriltag_family_t* (*create)();
-  void (*destroy)(apriltag_family_t*);
-};
-constexpr FamilyEntry kFamilies[] = {
-    {"tag36h11", tag36h11_create, tag36h11_destroy},
-    {"tag36h10", tag36h10_create, tag36h10_destroy},
-    {"tag25h9", tag25h9_create, tag25h9_destroy},
-    {"tag16h5", tag16h5_create, tag16h5_destroy},
-    {"tagCircle21h7", tagCircle21h7_create, tagCircle21h7_destroy},
-    {"tagCircle49h12", tagCircle49h12_create, tagCircle49h12_destroy},
-    {"tagCustom48h12", tagCustom48h12_create, tagCustom48h12_destroy},
-    {"tagStandard41h12", tagStandard41h12_create, tagStandard41h12_destroy},
-    {"tagStandard52h13", tagStandard52h13_create, tagStandard52h13_destroy},
-};
-
-const FamilyEntry& find_family(const std::string& name) {
-  for (const auto& f : kFamilies)
-    if (name == f.name) return f;
-  std::string known;
-  for (const auto& f : kFamilies) known += std::string(known.empty() ? "" : ", ") + f.name;
-  throw std::invalid_argument(fmt::format("tag capture: unknown tag family \"{}\" (known: {})", name, known));
-}
 
 void check_options(const TagCaptureOptions& o) {
   auto bad = [](const std::string& what) { throw std::invalid_argument("tag capture: " + what); };
@@ -150,15 +117,14 @@ struct TagTexture {
   std::vector<Rgb> texels;
 
   explicit TagTexture(const TagCaptureOptions& o) {
-    const FamilyEntry& entry = find_family(o.family);
-    apriltag_family_t* family = entry.create();
-    if (o.tag_id < 0 || uint32_t(o.tag_id) >= family->ncodes) {
-      const uint32_t ncodes = family->ncodes;
-      entry.destroy(family);
+    const TagFamilyPtr family = create_tag_family(o.family);
+    if (!family)
+      throw std::invalid_argument(fmt::format("tag capture: unknown tag family \"{}\" (known: {})", o.family,
+                                              joined_tag_family_names()));
+    if (o.tag_id < 0 || uint32_t(o.tag_id) >= family->ncodes)
       throw std::invalid_argument(
-          fmt::format("tag capture: tag id {} is outside {}'s 0..{}", o.tag_id, o.family, ncodes - 1));
-    }
-    image_u8_t* image = apriltag_to_image(family, o.tag_id);
+          fmt::format("tag capture: tag id {} is outside {}'s 0..{}", o.tag_id, o.family, family->ncodes - 1));
+    image_u8_t* image = apriltag_to_image(family.get(), o.tag_id);
     cells = image->width;
     // AprilTag's tag size is the black-border edge: width_at_border cells of the printed total_width.
     cell_m = o.tag_size_m / family->width_at_border;
@@ -170,7 +136,6 @@ struct TagTexture {
         for (int c = 0; c < 3; ++c) texels[size_t(row) * cells + col][c] = kInk[c] + (kPaper[c] - kInk[c]) * white;
       }
     image_u8_destroy(image);
-    entry.destroy(family);
   }
 };
 

@@ -2,18 +2,10 @@
 // checks every key, type and range, so the file and the command line are validated alike.
 #include "core/config/config.h"
 
+#include <apriltag/apriltag.h>
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
-#include <apriltag/tag16h5.h>
-#include <apriltag/tag25h9.h>
-#include <apriltag/tag36h10.h>
-#include <apriltag/tag36h11.h>
-#include <apriltag/tagCircle21h7.h>
-#include <apriltag/tagCircle49h12.h>
-#include <apriltag/tagCustom48h12.h>
-#include <apriltag/tagStandard41h12.h>
-#include <apriltag/tagStandard52h13.h>
 
 #include <algorithm>
 #include <cctype>
@@ -28,38 +20,14 @@
 #include <set>
 #include <sstream>
 
+#include "core/track/tag_family.h"
+
 namespace arpipe {
 
 namespace {
 
 constexpr double kRadiansPerDegree = std::numbers::pi / 180.0;
 constexpr const char* kOverridePrefix = "override '";
-
-struct TagFamily {
-  const char* name;
-  apriltag_family_t* (*create)();
-  void (*destroy)(apriltag_family_t*);
-};
-
-// libapriltag's own families; the id range of each comes from the library itself.
-constexpr TagFamily kTagFamilies[] = {
-    {"tag36h11", tag36h11_create, tag36h11_destroy},
-    {"tag25h9", tag25h9_create, tag25h9_destroy},
-    {"tag16h5", tag16h5_create, tag16h5_destroy},
-    {"tagStandard41h12", tagStandard41h12_create, tagStandard41h12_destroy},
-    {"tagStandard52h13", tagStandard52h13_create, tagStandard52h13_destroy},
-    {"tagCircle21h7", tagCircle21h7_create, tagCircle21h7_destroy},
-    {"tagCircle49h12", tagCircle49h12_create, tagCircle49h12_destroy},
-    {"tagCustom48h12", tagCustom48h12_create, tagCustom48h12_destroy},
-    {"tag36h10", tag36h10_create, tag36h10_destroy},
-};
-
-int64_t tag_family_code_count(const TagFamily& family) {
-  apriltag_family_t* created = family.create();
-  const int64_t count = created->ncodes;
-  family.destroy(created);
-  return count;
-}
 
 std::string join(const std::vector<std::string>& items) {
   std::string out;
@@ -290,11 +258,11 @@ void read_track(const ConfigReader& r, const toml::table& t, TrackConfig& out) {
   const std::string p = "track.";
   r.check_keys(t, p,
                {"enabled", "family", "bundle", "quad_decimate", "quad_sigma", "threads", "max_hamming",
-                "min_decision_margin", "ambiguity_ratio"},
+                "min_decision_margin", "ambiguity_ratio", "refine_corners"},
                "[track]");
   r.read(t, p, "enabled", out.enabled);
   std::vector<std::string> families;
-  for (const auto& family : kTagFamilies) families.emplace_back(family.name);
+  for (const auto family : tag_family_names()) families.emplace_back(family);
   r.read(t, p, "family", out.family, families);
   r.read(t, p, "quad_decimate", out.quad_decimate, [](double v) { return v >= 1; }, "a number >= 1");
   r.read(t, p, "quad_sigma", out.quad_sigma);  // negative sharpens in libapriltag, so any value goes
@@ -302,11 +270,10 @@ void read_track(const ConfigReader& r, const toml::table& t, TrackConfig& out) {
   r.read(t, p, "max_hamming", out.max_hamming, 0, 3);  // libapriltag corrects at most 3 bits
   r.read(t, p, "min_decision_margin", out.min_decision_margin, non_negative, "a number >= 0");
   r.read(t, p, "ambiguity_ratio", out.ambiguity_ratio, [](double v) { return v >= 1; }, "a number >= 1");
+  r.read(t, p, "refine_corners", out.refine_corners);
 
   if (const toml::array* bundle = r.array_of_tables(t, p, "bundle")) {
-    const auto family = std::find_if(std::begin(kTagFamilies), std::end(kTagFamilies),
-                                     [&](const TagFamily& f) { return out.family == f.name; });
-    const int64_t code_count = tag_family_code_count(*family);
+    const int64_t code_count = create_tag_family(out.family)->ncodes;
     out.bundle.clear();
     std::set<int> ids;
     for (size_t i = 0; i < bundle->size(); ++i) {
@@ -580,7 +547,7 @@ std::string default_config_toml() {
   out += "\n[track]\n";
   entry("enabled", b(d.track.enabled));
   std::vector<std::string> families;
-  for (const auto& family : kTagFamilies) families.emplace_back(family.name);
+  for (const auto family : tag_family_names()) families.emplace_back(family);
   entry("family", s(d.track.family), "one of " + join(families));
   entry("quad_decimate", f(d.track.quad_decimate), ">= 1: find quads in an image this many times smaller");
   entry("quad_sigma", f(d.track.quad_sigma), "blur before finding quads (negative sharpens)");
@@ -588,6 +555,7 @@ std::string default_config_toml() {
   entry("max_hamming", fmt::format("{}", d.track.max_hamming), "bit errors corrected, 0..3");
   entry("min_decision_margin", f(d.track.min_decision_margin), "weaker detections are ignored");
   entry("ambiguity_ratio", f(d.track.ambiguity_ratio), ">= 1: IPPE's two poses closer than this error ratio are ambiguous");
+  entry("refine_corners", b(d.track.refine_corners), "re-fit the tag borders in linear light (libapriltag's corners sit ~0.2 px inside)");
   out += "\n# The anchor: one [[track.bundle]] per tag, placed in the world (anchor) frame, lying in z = 0.\n";
   for (const BundleTag& tag : d.track.bundle) {
     out += "[[track.bundle]]\n";

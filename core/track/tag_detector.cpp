@@ -3,43 +3,16 @@
 #include "core/track/tag_detector.h"
 
 #include <apriltag/apriltag.h>
-#include <apriltag/tag16h5.h>
-#include <apriltag/tag25h9.h>
-#include <apriltag/tag36h10.h>
-#include <apriltag/tag36h11.h>
-#include <apriltag/tagCircle21h7.h>
-#include <apriltag/tagCircle49h12.h>
-#include <apriltag/tagCustom48h12.h>
-#include <apriltag/tagStandard41h12.h>
-#include <apriltag/tagStandard52h13.h>
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
 
 #include "core/log.h"
+#include "core/track/tag_family.h"
 
 namespace arpipe {
 namespace {
-
-struct FamilyEntry {
-  std::string_view name;
-  apriltag_family_t* (*create)();
-  void (*destroy)(apriltag_family_t*);
-};
-
-// Debian's libapriltag exports the create/destroy pair of every family, and little else.
-constexpr FamilyEntry kFamilies[] = {
-    {"tag16h5", tag16h5_create, tag16h5_destroy},
-    {"tag25h9", tag25h9_create, tag25h9_destroy},
-    {"tag36h10", tag36h10_create, tag36h10_destroy},
-    {"tag36h11", tag36h11_create, tag36h11_destroy},
-    {"tagCircle21h7", tagCircle21h7_create, tagCircle21h7_destroy},
-    {"tagCircle49h12", tagCircle49h12_create, tagCircle49h12_destroy},
-    {"tagCustom48h12", tagCustom48h12_create, tagCustom48h12_destroy},
-    {"tagStandard41h12", tagStandard41h12_create, tagStandard41h12_destroy},
-    {"tagStandard52h13", tagStandard52h13_create, tagStandard52h13_destroy},
-};
 
 // libapriltag's decoder cannot correct more than 3 bits, and its quick-decode table holds every
 // code with up to max_hamming flipped bits: measured here, 36h11 needs 36 MB at 2 bits but 1.2 GB
@@ -57,38 +30,25 @@ std::string config_source(const Config& config) {
   return config.file.empty() ? std::string("config") : config.file.string();
 }
 
-std::string joined_family_names() {
-  std::string names;
-  for (const auto& family : kFamilies) {
-    if (!names.empty()) names += ", ";
-    names += family.name;
-  }
-  return names;
-}
-
 }  // namespace
 
 struct TagDetector::Impl {
-  const FamilyEntry* entry = nullptr;
-  apriltag_family_t* family = nullptr;
+  TagFamilyPtr family{nullptr, nullptr};
   apriltag_detector_t* detector = nullptr;
   std::string family_name;
 
   ~Impl() {
     // The detector holds pointers into the family, so it goes first.
     if (detector) apriltag_detector_destroy(detector);
-    if (family) entry->destroy(family);
   }
 };
 
 TagDetector::TagDetector(const Config& config) : impl_(std::make_unique<Impl>()) {
   const TrackConfig& track = config.track;
   const std::string source = config_source(config);
-  const auto entry = std::find_if(std::begin(kFamilies), std::end(kFamilies),
-                                  [&](const FamilyEntry& e) { return e.name == track.family; });
-  if (entry == std::end(kFamilies)) {
+  if (!is_tag_family(track.family)) {
     throw ConfigError(fmt::format("{}: track.family: unknown AprilTag family '{}' (expected one of: {})", source,
-                                  track.family, joined_family_names()));
+                                  track.family, joined_tag_family_names()));
   }
   if (!(track.quad_decimate >= 1.0) || !std::isfinite(track.quad_decimate)) {
     throw ConfigError(fmt::format("{}: track.quad_decimate: expected a number >= 1, got {}", source,
@@ -105,9 +65,8 @@ TagDetector::TagDetector(const Config& config) : impl_(std::make_unique<Impl>())
                                   track.max_hamming));
   }
 
-  impl_->entry = &*entry;
-  impl_->family_name = std::string(entry->name);
-  impl_->family = entry->create();
+  impl_->family_name = track.family;
+  impl_->family = create_tag_family(track.family);
 
   double table_entries = 0;
   for (int bits = 0; bits <= track.max_hamming; ++bits) {
@@ -126,16 +85,11 @@ TagDetector::TagDetector(const Config& config) : impl_(std::make_unique<Impl>())
   impl_->detector->quad_sigma = static_cast<float>(track.quad_sigma);
   impl_->detector->nthreads = track.threads;
   impl_->detector->refine_edges = true;
-  apriltag_detector_add_family_bits(impl_->detector, impl_->family, track.max_hamming);
+  apriltag_detector_add_family_bits(impl_->detector, impl_->family.get(), track.max_hamming);
 }
 
 TagDetector::~TagDetector() = default;
 
-std::vector<std::string_view> TagDetector::family_names() {
-  std::vector<std::string_view> names;
-  for (const auto& family : kFamilies) names.push_back(family.name);
-  return names;
-}
 
 const std::string& TagDetector::family() const { return impl_->family_name; }
 

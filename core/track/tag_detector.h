@@ -24,9 +24,6 @@ class TagDetector {
   TagDetector(const TagDetector&) = delete;
   TagDetector& operator=(const TagDetector&) = delete;
 
-  // Every libapriltag family this build knows, by its libapriltag name ("tag36h11", ...).
-  static std::vector<std::string_view> family_names();
-
   const std::string& family() const;
   // Number of distinct ids in the family (valid ids are 0 .. code_count()-1).
   int code_count() const;

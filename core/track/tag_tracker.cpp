@@ -147,7 +147,7 @@ void TagTracker::Impl::track(FrameContext& ctx) {
                         observation.decision_margin >= config.min_decision_margin;
     // Only tags that count are refined (it costs a few hundred unprojections); the others keep
     // libapriltag's corners. A tag too small to refine keeps them as well.
-    if (usable) {
+    if (usable && config.refine_corners) {
       refiner.refine(pixels, frame.width, frame.height, stride, *ctx.camera_model, detector->border_cells(),
                      observation.corners);
     }

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/track/tag_corner_refiner.h"
+#include "core/track/tag_family.h"
 
 namespace arpipe {
 namespace {
@@ -156,7 +157,7 @@ TEST(TagCornerRefiner, LeavesTagsTooSmallToRefineAlone) {
 }
 
 TEST(TagDetector, KnowsEveryLibapriltagFamilyByName) {
-  const auto names = TagDetector::family_names();
+  const auto names = tag_family_names();
   EXPECT_EQ(names.size(), 9u);
   for (const auto name : names) {
     Config config;
