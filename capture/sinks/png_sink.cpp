@@ -4,6 +4,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <algorithm>
 #include <stdexcept>
 
 #include "capture/sinks/output_path.h"
@@ -11,7 +12,7 @@
 
 namespace arpipe {
 
-PngSink::PngSink(const PngSinkConfig& config) : dir_(config.dir), every_(config.every) {
+PngSink::PngSink(const PngSinkConfig& config) : dir_(config.dir), every_(std::max(1, config.every)) {
   create_output_directory(dir_, "sinks.png.dir");
 }
 

@@ -126,6 +126,10 @@ void PipelineRunner::processing_loop() {
     to_sink_->push(std::move(*ctx));
   }
   to_sink_->close();
+  {
+    std::lock_guard lock(reconfigure_mutex_);
+    processing_ended_ = true;  // later reloads are answered at once
+  }
   apply_pending_reconfigure();  // answer a reload that raced with the end of the stream
   stages_.clear();              // destroys the GL context on the thread that made it
 }
@@ -147,6 +151,10 @@ bool PipelineRunner::reconfigure(const Config& config, std::string& error) {
   auto answer = request->result.get_future();
   {
     std::lock_guard lock(reconfigure_mutex_);
+    if (processing_ended_) {
+      error = "the stream has ended; nothing left to reconfigure";
+      return false;
+    }
     pending_reconfigure_ = request;
   }
   // The processing thread picks it up before its next frame.

@@ -65,6 +65,7 @@ class PipelineRunner {
   struct PendingReconfigure;
   std::mutex reconfigure_mutex_;
   std::shared_ptr<PendingReconfigure> pending_reconfigure_;
+  bool processing_ended_ = false;  // guarded by reconfigure_mutex_
   int64_t start_ns_ = 0;
 
   mutable std::mutex metrics_mutex_;

@@ -56,10 +56,11 @@ bool tag_out_of_view(const CameraModel& model, const SE3& T_cam_world) {
   return true;
 }
 
+// ctest runs each test in its own process, in parallel, so each run gets its own output folder.
 class DefaultReplay : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    out_ = fs::path(ARPIPE_BINARY_DIR) / "e2e-out" / "default-replay";
+    out_ = fs::path(ARPIPE_BINARY_DIR) / "e2e-out" / ("default-replay-" + std::to_string(getpid()));
     fs::remove_all(out_);
     fs::create_directories(out_);
     ASSERT_TRUE(fs::exists(kCapture / "recording.json")) << "the build generates " << kCapture;
@@ -71,6 +72,9 @@ class DefaultReplay : public ::testing::Test {
          "sinks.results.path=\"" + (out_ / "results.jsonl").string() + "\""},
         out_ / "logs", &stderr_);
     exit_code_ = code;
+  }
+  static void TearDownTestSuite() {
+    if (!::testing::UnitTest::GetInstance()->Failed()) fs::remove_all(out_);
   }
   static inline fs::path out_;
   static inline std::string stderr_;
