@@ -30,12 +30,14 @@ inline std::string read_text(const std::filesystem::path& path) {
 
 class ChildProcess {
  public:
+  // env: extra "NAME=value" entries for the child's environment.
   ChildProcess(const std::filesystem::path& program, const std::vector<std::string>& args,
-               const std::filesystem::path& log_dir)
+               const std::filesystem::path& log_dir, const std::vector<std::string>& env = {})
       : stdout_path_(log_dir / "stdout.txt"), stderr_path_(log_dir / "stderr.txt") {
     std::filesystem::create_directories(log_dir);
     pid_ = fork();
     if (pid_ == 0) {
+      for (const auto& entry : env) putenv(const_cast<char*>(entry.c_str()));
       if (!freopen(stdout_path_.c_str(), "w", stdout) || !freopen(stderr_path_.c_str(), "w", stderr)) _exit(127);
       std::vector<char*> argv;
       std::string prog = program.string();
