@@ -472,6 +472,9 @@ TEST(PipelineRunner, StopWhileTheSourceBlocksInterruptsItDrainsAndFlushes) {
   h.runner->start();
   h.wait_until_sink_has(0, 3);
   h.wait_until_sink_has(1, 3);
+  // The fourth call of next() is the one that blocks; stop only once it has begun, or the capture
+  // thread may see the stop request first and never call it.
+  h.source_log->wait_for([&] { return h.source_log->next_calls >= 4; });
   EXPECT_FALSE(h.runner->finished());
   h.runner->stop();
   h.runner->wait();  // returns only if stop() reached the blocked next()
