@@ -108,14 +108,8 @@ void CompositeStage::process(FrameContext& ctx) noexcept {
 
 void CompositeStage::ensure_targets(int width, int height) {
   if (width == width_ && height == height_) return;
-  camera_texture_ = GlTexture::create();
-  glBindTexture(GL_TEXTURE_2D, camera_texture_.get());
-  glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGB8, width, height);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-  output_texture_ = GlTexture::create();
-  glBindTexture(GL_TEXTURE_2D, output_texture_.get());
-  glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA8, width, height);
+  camera_texture_ = create_texel_texture(GL_RGB8, width, height);
+  output_texture_ = create_texel_texture(GL_RGBA8, width, height);
   output_framebuffer_ = GlFramebuffer::create();
   glBindFramebuffer(GL_FRAMEBUFFER, output_framebuffer_.get());
   glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, output_texture_.get(), 0);

@@ -46,4 +46,15 @@ using GlFramebuffer = GlObject<glGenFramebuffers, glDeleteFramebuffers>;
 using GlRenderbuffer = GlObject<glGenRenderbuffers, glDeleteRenderbuffers>;
 using GlVertexArray = GlObject<glGenVertexArrays, glDeleteVertexArrays>;
 
+// A 2D texture of fixed size and format read texel for texel: one level, nearest filtering (a
+// texture without mipmaps is only complete with a non-mipmap filter). Leaves it bound.
+inline GlTexture create_texel_texture(GLenum internal_format, int width, int height) {
+  GlTexture texture = GlTexture::create();
+  glBindTexture(GL_TEXTURE_2D, texture.get());
+  glTexStorage2D(GL_TEXTURE_2D, 1, internal_format, width, height);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  return texture;
+}
+
 }  // namespace arpipe

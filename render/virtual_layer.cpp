@@ -27,12 +27,7 @@ void VirtualLayer::ensure(int width, int height, int msaa_samples) {
     log::warn("render: msaa_samples = {} is more than this GL supports for the virtual layer; using {}", msaa_samples,
               max_samples_);
 
-  resolved_texture_ = GlTexture::create();
-  glBindTexture(GL_TEXTURE_2D, resolved_texture_.get());
-  glTexStorage2D(GL_TEXTURE_2D, 1, color_format_, width, height);
-  // The composite stage reads it with texelFetch, but a complete texture needs a non-mipmap filter.
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  resolved_texture_ = create_texel_texture(color_format_, width, height);  // the composite stage texelFetches it
   resolved_framebuffer_ = GlFramebuffer::create();
   glBindFramebuffer(GL_FRAMEBUFFER, resolved_framebuffer_.get());
   glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, resolved_texture_.get(), 0);
