@@ -1,7 +1,6 @@
 #include "capture/sinks/results_sink.h"
 
 #include <fmt/format.h>
-#include <unistd.h>
 
 #include <cerrno>
 #include <cstring>
@@ -13,17 +12,7 @@
 
 namespace arpipe {
 
-ResultsSink::ResultsSink(const ResultsSinkConfig& config) : path_(config.path) {
-  create_parent_directory(path_, "sinks.results.path");
-  file_ = std::fopen(path_.c_str(), "w");
-  if (!file_) throw std::runtime_error(fmt::format("{} (config sinks.results.path): cannot open for writing: {}",
-                                                   path_.string(), std::strerror(errno)));
-}
-
-ResultsSink::~ResultsSink() {
-  flush();
-  if (file_) std::fclose(file_);
-}
+ResultsSink::ResultsSink(const ResultsSinkConfig& config) : path_(config.path), file_(path_, "sinks.results.path") {}
 
 std::string ResultsSink::describe() const { return "results:" + path_.string(); }
 
@@ -61,21 +50,16 @@ std::string ResultsSink::to_json_line(const FrameContext& ctx) {
 }
 
 void ResultsSink::consume(const FrameContext& ctx) noexcept {
-  if (!file_) return;
   try {
     const std::string line = to_json_line(ctx) + "\n";
     // One line per frame, flushed, so a crash loses at most the frame being written.
-    if (std::fwrite(line.data(), 1, line.size(), file_) != line.size() || std::fflush(file_) != 0)
+    if (std::fwrite(line.data(), 1, line.size(), file_.get()) != line.size() || std::fflush(file_.get()) != 0)
       throw std::runtime_error(std::strerror(errno));
   } catch (const std::exception& e) {
     if (failures_++ == 0) log::error("{}: cannot write frame {}: {}", path_.string(), ctx.input_index, e.what());
   }
 }
 
-void ResultsSink::flush() noexcept {
-  if (!file_) return;
-  std::fflush(file_);
-  ::fsync(fileno(file_));
-}
+void ResultsSink::flush() noexcept { file_.sync(); }
 
 }  // namespace arpipe

@@ -2,9 +2,9 @@
 // point's pixel, timings and skip reasons. End-to-end tests and people read it; lines are flushed.
 #pragma once
 
-#include <cstdio>
 #include <filesystem>
 
+#include "capture/sinks/output_path.h"
 #include "core/config/config.h"
 #include "core/pipeline/frame_sink.h"
 
@@ -13,7 +13,6 @@ namespace arpipe {
 class ResultsSink : public FrameSink {
  public:
   explicit ResultsSink(const ResultsSinkConfig& config);  // throws std::runtime_error naming the file
-  ~ResultsSink() override;
   std::string describe() const override;
   void consume(const FrameContext& ctx) noexcept override;
   void flush() noexcept override;
@@ -23,7 +22,7 @@ class ResultsSink : public FrameSink {
 
  private:
   std::filesystem::path path_;
-  FILE* file_ = nullptr;
+  OutputFile file_;
   uint64_t failures_ = 0;
 };
 

@@ -15,17 +15,7 @@
 
 namespace arpipe {
 
-Y4mSink::Y4mSink(const Y4mSinkConfig& config) : path_(config.path) {
-  create_parent_directory(path_, "sinks.y4m.path");
-  file_ = std::fopen(path_.c_str(), "wb");
-  if (!file_) throw std::runtime_error(fmt::format("{} (config sinks.y4m.path): cannot open for writing: {}",
-                                                   path_.string(), std::strerror(errno)));
-}
-
-Y4mSink::~Y4mSink() {
-  flush();
-  if (file_) std::fclose(file_);
-}
+Y4mSink::Y4mSink(const Y4mSinkConfig& config) : path_(config.path), file_(path_, "sinks.y4m.path") {}
 
 std::string Y4mSink::describe() const { return "y4m:" + path_.string(); }
 
@@ -43,11 +33,11 @@ bool Y4mSink::write_header(const FrameContext& first) {
     den /= g;
   }
   const std::string header = fmt::format("YUV4MPEG2 W{} H{} F{}:{} Ip A1:1 C420jpeg\n", width_, height_, num, den);
-  return std::fwrite(header.data(), 1, header.size(), file_) == header.size();
+  return std::fwrite(header.data(), 1, header.size(), file_.get()) == header.size();
 }
 
 void Y4mSink::consume(const FrameContext& ctx) noexcept {
-  if (!file_ || write_failed_ || ctx.output.empty()) return;
+  if (write_failed_ || ctx.output.empty()) return;
   try {
     if (frames_written_ == 0 && !write_header(ctx)) throw std::system_error(errno, std::generic_category(), "header");
     if ((ctx.output.width & ~1) != width_ || (ctx.output.height & ~1) != height_)
@@ -63,7 +53,7 @@ void Y4mSink::consume(const FrameContext& ctx) noexcept {
     }
     rgb24_to_i420(rgb, ctx.output.width, width_, height_, i420_);
     static const char kFrame[] = "FRAME\n";
-    if (std::fwrite(kFrame, 1, 6, file_) != 6 || std::fwrite(i420_.data(), 1, i420_.size(), file_) != i420_.size())
+    if (std::fwrite(kFrame, 1, 6, file_.get()) != 6 || std::fwrite(i420_.data(), 1, i420_.size(), file_.get()) != i420_.size())
       throw std::system_error(errno, std::generic_category(), "frame");
     ++frames_written_;
   } catch (const std::system_error& e) {
@@ -78,10 +68,6 @@ void Y4mSink::consume(const FrameContext& ctx) noexcept {
   }
 }
 
-void Y4mSink::flush() noexcept {
-  if (!file_) return;
-  std::fflush(file_);
-  ::fsync(fileno(file_));
-}
+void Y4mSink::flush() noexcept { file_.sync(); }
 
 }  // namespace arpipe

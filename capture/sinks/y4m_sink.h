@@ -1,10 +1,10 @@
 // Writes composited frames as one YUV4MPEG2 (Y4M) video, 4:2:0, which ffmpeg and mpv play.
 #pragma once
 
-#include <cstdio>
 #include <filesystem>
 #include <vector>
 
+#include "capture/sinks/output_path.h"
 #include "core/config/config.h"
 #include "core/pipeline/frame_sink.h"
 
@@ -13,7 +13,6 @@ namespace arpipe {
 class Y4mSink : public FrameSink {
  public:
   explicit Y4mSink(const Y4mSinkConfig& config);  // opens the file; throws std::runtime_error naming it
-  ~Y4mSink() override;
   std::string describe() const override;
   void consume(const FrameContext& ctx) noexcept override;
   void flush() noexcept override;
@@ -22,7 +21,7 @@ class Y4mSink : public FrameSink {
  private:
   bool write_header(const FrameContext& first);
   std::filesystem::path path_;
-  FILE* file_ = nullptr;
+  OutputFile file_;
   int width_ = 0, height_ = 0;
   uint64_t frames_written_ = 0;
   uint64_t failures_ = 0;
