@@ -1,0 +1,133 @@
+// The `arpipe` utility as a person runs it: inspect, replay, generate, config; bad input exits 2
+// with a message naming the file, never a crash.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "capture/recording/recording_reader.h"
+#include "capture/recording/recording_writer.h"
+#include "tests/e2e/child_process.h"
+
+namespace fs = std::filesystem;
+using namespace arpipe;
+
+namespace {
+
+const fs::path kCapture = fs::path(ARPIPE_BINARY_DIR) / "default-capture";
+
+class ArpipeCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::path(ARPIPE_BINARY_DIR) / "e2e-out" / ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  int run(const std::vector<std::string>& args, std::string* out = nullptr, std::string* err = nullptr) {
+    test::ChildProcess child(test::build_program("arpipe"), args, dir_ / "logs");
+    const int status = child.wait();
+    if (out) *out = child.stdout_text();
+    if (err) *err = child.stderr_text();
+    if (status == -1 || !WIFEXITED(status)) return -1;  // a timeout or a crash
+    return WEXITSTATUS(status);
+  }
+  fs::path dir_;
+};
+
+TEST_F(ArpipeCli, InspectSummarisesTheDefaultCapture) {
+  std::string out, err;
+  ASSERT_EQ(run({"inspect", kCapture.string()}, &out, &err), 0) << err;
+  RecordingReader reader(kCapture);  // the numbers the summary must show
+  EXPECT_NE(out.find("YUYV 640x480"), std::string::npos) << out;
+  EXPECT_NE(out.find("frames       " + std::to_string(reader.frame_count())), std::string::npos) << out;
+  EXPECT_NE(out.find("0 dropped"), std::string::npos) << out;
+  EXPECT_NE(out.find("30.00 frames/s"), std::string::npos) << out;  // the generator's rate
+  EXPECT_NE(out.find("ground truth yes"), std::string::npos) << out;
+}
+
+TEST_F(ArpipeCli, InspectCountsSequenceGaps) {
+  // Sequence numbers 0, 1, 2, 5, 6: a driver lost 3 and 4.
+  const fs::path capture = dir_ / "gappy";
+  {
+    RecordingInfo info;
+    info.pixel_format = PixelFormat::GREY;
+    info.width = 8;
+    info.height = 6;
+    info.source = "test";
+    RecordingWriter writer(capture, info, CameraModel::pinhole(10, 10, 3.5, 2.5, 8, 6));
+    for (uint64_t sequence : {0, 1, 2, 5, 6}) {
+      Frame frame = Frame::allocate(PixelFormat::GREY, 8, 6);
+      frame.meta.sequence = sequence;
+      frame.meta.exposure_start_ns = int64_t(sequence) * 33'333'333;
+      frame.meta.frame_duration_ns = 33'333'333;
+      writer.append(frame);
+    }
+  }
+  std::string out, err;
+  ASSERT_EQ(run({"inspect", capture.string()}, &out, &err), 0) << err;
+  EXPECT_NE(out.find("0 .. 6, 2 dropped"), std::string::npos) << out;
+}
+
+TEST_F(ArpipeCli, InspectOfAMissingRecordingNamesIt) {
+  std::string err;
+  EXPECT_EQ(run({"inspect", (dir_ / "nothing-here").string()}, nullptr, &err), 2);
+  EXPECT_NE(err.find("nothing-here"), std::string::npos) << err;
+}
+
+TEST_F(ArpipeCli, GenerateThenReplay) {
+  const fs::path capture = dir_ / "small";
+  std::string err;
+  ASSERT_EQ(run({"generate", "--out", capture.string(), "--frames", "5", "--format", "NV12", "--seed", "7"}, nullptr,
+                &err),
+            0)
+      << err;
+  RecordingReader reader(capture);
+  EXPECT_EQ(reader.frame_count(), 5u);
+  EXPECT_EQ(reader.info().pixel_format, PixelFormat::NV12);
+  EXPECT_EQ(reader.ground_truth().size(), 5u);
+  // Refuses to overwrite a recording.
+  EXPECT_EQ(run({"generate", "--out", capture.string()}, nullptr, &err), 2);
+  EXPECT_NE(err.find(capture.string()), std::string::npos) << err;
+
+  ASSERT_EQ(run({"replay", capture.string(), "--set", "sinks.png.enabled=false", "--set",
+                 "sinks.y4m.path=\"" + (dir_ / "o.y4m").string() + "\"", "--set",
+                 "sinks.results.path=\"" + (dir_ / "r.jsonl").string() + "\""},
+                nullptr, &err),
+            0)
+      << err;
+  std::ifstream results(dir_ / "r.jsonl");
+  size_t lines = 0;
+  for (std::string line; std::getline(results, line);) ++lines;
+  EXPECT_EQ(lines, 5u);
+}
+
+TEST_F(ArpipeCli, GenerateRejectsBadOptions) {
+  std::string err;
+  EXPECT_EQ(run({"generate", "--out", (dir_ / "x").string(), "--format", "MJPG"}, nullptr, &err), 2);
+  EXPECT_NE(err.find("MJPG"), std::string::npos) << err;
+  EXPECT_EQ(run({"generate", "--out", (dir_ / "x").string(), "--frames", "-3"}, nullptr, &err), 2);
+  EXPECT_NE(err.find("-3"), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(dir_ / "x"));
+}
+
+TEST_F(ArpipeCli, ConfigDefaultsAreAValidConfigAndCheckNamesErrors) {
+  std::string out, err;
+  ASSERT_EQ(run({"config", "--defaults"}, &out, &err), 0) << err;
+  std::ofstream(dir_ / "defaults.toml") << out;
+  EXPECT_EQ(run({"config", "--check", (dir_ / "defaults.toml").string()}, &out, &err), 0) << err;
+  EXPECT_EQ(run({"config", "--check", (fs::path(ARPIPE_SOURCE_DIR) / "configs" / "arpipe.toml").string()}, &out, &err),
+            0)
+      << err;
+  std::ofstream(dir_ / "bad.toml") << "[render]\nmsaa_samples = 3\n";
+  EXPECT_EQ(run({"config", "--check", (dir_ / "bad.toml").string()}, &out, &err), 2);
+  EXPECT_NE(err.find("bad.toml"), std::string::npos) << err;
+  EXPECT_NE(err.find("msaa_samples"), std::string::npos) << err;
+}
+
+TEST_F(ArpipeCli, UnknownCommandIsAUsageError) {
+  std::string err;
+  EXPECT_EQ(run({"frobnicate"}, nullptr, &err), 2);
+  EXPECT_NE(err.find("frobnicate"), std::string::npos) << err;
+}
+
+}  // namespace
