@@ -97,7 +97,7 @@ int run_daemon(const DaemonOptions& options) {
     } else if (sig == SIGHUP && !stopping) {
       reload(*runner, options, config, systemd);
     }
-    // A processing thread stuck inside one frame for a whole watchdog interval stops the pings.
+    // A stage or sink stuck inside one frame for a whole watchdog interval stops the pings.
     if (watchdog_ns > 0 && runner->healthy(watchdog_ns)) systemd.watchdog_ping();
     const int64_t now = monotonic_now_ns();
     if (now - last_status_ns > 2'000'000'000) {

@@ -136,7 +136,9 @@ void PipelineRunner::processing_loop() {
 
 void PipelineRunner::sink_loop() {
   while (auto ctx = to_sink_->pop()) {
+    sink_busy_since_ns_ = monotonic_now_ns();
     for (auto& sink : sinks_) sink->consume(*ctx);
+    sink_busy_since_ns_ = 0;
     std::lock_guard lock(metrics_mutex_);
     ++metrics_.frames_out;
     metrics_.wall_seconds = double(monotonic_now_ns() - start_ns_) * 1e-9;
@@ -207,8 +209,10 @@ PipelineMetrics PipelineRunner::metrics() const {
 }
 
 bool PipelineRunner::healthy(int64_t max_stall_ns) const {
-  const int64_t since = busy_since_ns_.load();
-  return since == 0 || monotonic_now_ns() - since < max_stall_ns;
+  const int64_t now = monotonic_now_ns();
+  for (const int64_t since : {busy_since_ns_.load(), sink_busy_since_ns_.load()})
+    if (since != 0 && now - since >= max_stall_ns) return false;
+  return true;
 }
 
 }  // namespace arpipe

@@ -40,8 +40,9 @@ class PipelineRunner {
   bool reconfigure(const Config& config, std::string& error);
 
   PipelineMetrics metrics() const;
-  // False when the processing thread has been inside one frame for longer than max_stall_ns
-  // (the watchdog stops pinging, so systemd restarts a stuck daemon). Idle waiting is healthy.
+  // False when the processing or the sink thread has been inside one frame for longer than
+  // max_stall_ns (a hung stage or disk: the watchdog stops pinging, so systemd restarts the daemon).
+  // Idle waiting is healthy.
   bool healthy(int64_t max_stall_ns) const;
 
  private:
@@ -59,7 +60,8 @@ class PipelineRunner {
   std::thread capture_thread_, processing_thread_, sink_thread_;
   std::atomic<bool> stop_requested_{false};
   std::atomic<bool> finished_{false};
-  std::atomic<int64_t> busy_since_ns_{0};  // 0 while the processing thread waits for a frame
+  std::atomic<int64_t> busy_since_ns_{0};       // 0 while the processing thread waits for a frame
+  std::atomic<int64_t> sink_busy_since_ns_{0};  // 0 while the sink thread waits for a frame
 
   void apply_pending_reconfigure();
   struct PendingReconfigure;

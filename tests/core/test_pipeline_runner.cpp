@@ -609,13 +609,35 @@ TEST(PipelineRunner, UnhealthyWhileAStageIsStuckHealthyWhenIdle) {
     release->changed.notify_all();
   }
   h.wait_until_sink_has(0, 1);
-  // The processing thread now waits for a frame the source does not have: idle is healthy,
-  // even with a threshold of 1 ns.
+  while (h.runner->metrics().frames_out < 1) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  // Both threads now wait for a frame the source does not have: idle is healthy, even with a
+  // threshold of 1 ns.
   EXPECT_TRUE(h.runner->healthy(1));
 
   h.runner->stop();
   h.runner->wait();
   EXPECT_TRUE(h.runner->healthy(1));
+}
+
+// A sink stuck on a hung disk must stop the watchdog too, not only a stuck stage.
+TEST(PipelineRunner, UnhealthyWhileASinkIsStuck) {
+  Harness h(Setup::replaying(frames_0_to(1), AfterScript::BlockUntilInterrupted)
+                .with_sink_delays({std::chrono::microseconds(1'000'000)}));
+  h.runner->start();
+  // The sink sits in consume() for a whole second (sleep_for never returns early), so a 10 ms
+  // threshold is crossed while the test watches, however the threads are scheduled.
+  bool seen_unhealthy = false;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(900);
+  while (!seen_unhealthy && std::chrono::steady_clock::now() < deadline) {
+    seen_unhealthy = !h.runner->healthy(10'000'000);
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  EXPECT_TRUE(seen_unhealthy);
+  h.wait_until_sink_has(0, 1);
+  while (h.runner->metrics().frames_out < 1) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  EXPECT_TRUE(h.runner->healthy(1));
+  h.runner->stop();
+  h.runner->wait();
 }
 
 }  // namespace
