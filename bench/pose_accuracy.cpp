@@ -11,6 +11,7 @@
 
 #include "capture/recording/recording_reader.h"
 #include "core/log.h"
+#include "core/pipeline/monotonic_clock.h"
 #include "core/track/tag_tracker.h"
 
 using namespace arpipe;
@@ -44,7 +45,7 @@ Errors measure(const RecordingReader& reader, const std::vector<Frame>& frames, 
       ctx.camera_model = model;
       const auto start = std::chrono::steady_clock::now();
       tracker.process(ctx);
-      const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+      const double ms = milliseconds_since(start);
       if (pass == 0) continue;
       e.ms.push_back(ms);
       if (pass != 1) continue;

@@ -9,6 +9,7 @@
 
 #include "core/image/pixel_convert.h"
 #include "core/log.h"
+#include "core/pipeline/monotonic_clock.h"
 #include "render/gl_error.h"
 #include "render/render_errors.h"
 
@@ -46,10 +47,6 @@ void main() {
 }
 )glsl";
 
-double elapsed_ms(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-}
-
 void pass_through(FrameContext& ctx) {
   ctx.output = Frame::allocate(PixelFormat::RGB24, ctx.camera.width, ctx.camera.height);
   ctx.output.meta = ctx.camera.meta;
@@ -86,11 +83,11 @@ void CompositeStage::process(FrameContext& ctx) noexcept {
   try {
     if (!ctx.virtual_layer_drawn) {
       pass_through(ctx);
-      ctx.record_timing(std::string(name()), elapsed_ms(start), "nothing virtual drawn: pass-through");
+      ctx.record_timing(std::string(name()), milliseconds_since(start), "nothing virtual drawn: pass-through");
       return;
     }
     composite(ctx);
-    ctx.record_timing(std::string(name()), elapsed_ms(start));
+    ctx.record_timing(std::string(name()), milliseconds_since(start));
     last_error_.clear();
   } catch (const std::exception& e) {
     if (last_error_ != e.what()) log::error("composite: {}", e.what());
@@ -100,9 +97,9 @@ void CompositeStage::process(FrameContext& ctx) noexcept {
     } catch (...) {
       ctx.output = Frame();
     }
-    ctx.record_timing(std::string(name()), elapsed_ms(start), fmt::format("error: {}", e.what()));
+    ctx.record_timing(std::string(name()), milliseconds_since(start), fmt::format("error: {}", e.what()));
   } catch (...) {
-    ctx.record_timing(std::string(name()), elapsed_ms(start), "error: unknown exception");
+    ctx.record_timing(std::string(name()), milliseconds_since(start), "error: unknown exception");
   }
 }
 

@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "core/log.h"
+#include "core/pipeline/monotonic_clock.h"
 #include "render/gl_error.h"
 #include "render/lens_projection.h"
 #include "render/projected_bounds.h"
@@ -50,10 +51,6 @@ void main() {
 
 // Covers the multisampled edge pixels and the bend of distorted edges between sampled points.
 constexpr double kRectMarginPx = 2.0;
-
-double elapsed_ms(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-}
 
 // Column-major, as glUniformMatrix3fv wants it without transposing.
 std::array<float, 9> column_major(const Mat3& m, double scale) {
@@ -108,24 +105,24 @@ void RenderStage::process(FrameContext& ctx) noexcept {
     else if (objects_.empty()) skip = "no objects";
     else if (ctx.pose.state != TrackState::Tracking) skip = fmt::format("pose {}", track_state_name(ctx.pose.state));
     if (!skip.empty()) {
-      ctx.record_timing(std::string(name()), elapsed_ms(start), std::move(skip));
+      ctx.record_timing(std::string(name()), milliseconds_since(start), std::move(skip));
       return;
     }
     draw(ctx);
     if (ctx.virtual_layer_drawn) {
-      ctx.record_timing(std::string(name()), elapsed_ms(start));
+      ctx.record_timing(std::string(name()), milliseconds_since(start));
       last_error_.clear();
     } else {
-      ctx.record_timing(std::string(name()), elapsed_ms(start), "objects out of view");
+      ctx.record_timing(std::string(name()), milliseconds_since(start), "objects out of view");
     }
   } catch (const std::exception& e) {
     ctx.virtual_layer_drawn = false;
     if (last_error_ != e.what()) log::error("render: {}", e.what());
     last_error_ = e.what();
-    ctx.record_timing(std::string(name()), elapsed_ms(start), fmt::format("error: {}", e.what()));
+    ctx.record_timing(std::string(name()), milliseconds_since(start), fmt::format("error: {}", e.what()));
   } catch (...) {
     ctx.virtual_layer_drawn = false;
-    ctx.record_timing(std::string(name()), elapsed_ms(start), "error: unknown exception");
+    ctx.record_timing(std::string(name()), milliseconds_since(start), "error: unknown exception");
   }
 }
 

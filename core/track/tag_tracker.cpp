@@ -12,6 +12,7 @@
 
 #include "core/image/pixel_convert.h"
 #include "core/log.h"
+#include "core/pipeline/monotonic_clock.h"
 #include "core/track/bundle_tag_geometry.h"
 #include "core/track/tag_corner_refiner.h"
 #include "core/track/tag_detector.h"
@@ -201,7 +202,7 @@ void TagTracker::process(FrameContext& ctx) noexcept {
     ctx.pose.state = TrackState::Lost;
     impl_->previous_pose.reset();
   }
-  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  const double ms = milliseconds_since(start);
   try {
     ctx.record_timing("track", ms, std::move(skipped));
   } catch (...) {
