@@ -36,19 +36,17 @@ sigset_t block_control_signals() {
   return set;
 }
 
-void reload(PipelineRunner& runner, const DaemonOptions& options, Config& running, SystemdNotifier& systemd) {
+// The runner keeps the stages' config; `started` is only what the source and queues were built from.
+void reload(PipelineRunner& runner, const DaemonOptions& options, const Config& started, SystemdNotifier& systemd) {
   systemd.reloading();
   log::info("SIGHUP: reloading {}", options.config_path.string());
   try {
     Config next = load_config(options.config_path, options.overrides);
-    if (next.source.path != running.source.path || next.source.type != running.source.type ||
-        next.pipeline.queue_depth != running.pipeline.queue_depth)
+    if (next.source != started.source || next.pipeline.queue_depth != started.pipeline.queue_depth)
       log::warn("{}: source and pipeline changes take effect at the next restart; stages and lighting now",
                 options.config_path.string());
     std::string error;
     if (runner.reconfigure(next, error)) {
-      running.track = next.track;
-      running.render = next.render;
       log::set_max_level(level_from_name(next.pipeline.log_level));
       log::info("reload accepted");
     } else {
