@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "render/gl_objects.h"
-#include "render/mesh.h"
+#include "core/scene/mesh.h"
 
 namespace arpipe {
 

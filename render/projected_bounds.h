@@ -6,7 +6,7 @@
 
 #include "core/geometry/camera_model.h"
 #include "core/geometry/se3.h"
-#include "render/mesh.h"
+#include "core/scene/mesh.h"
 #include "render/pixel_rect.h"
 
 namespace arpipe {

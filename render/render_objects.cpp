@@ -7,8 +7,8 @@
 #include <cmath>
 #include <map>
 
-#include "render/builtin_meshes.h"
-#include "render/gltf_loader.h"
+#include "core/scene/builtin_meshes.h"
+#include "core/scene/gltf_loader.h"
 
 namespace arpipe {
 namespace {

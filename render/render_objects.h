@@ -11,7 +11,7 @@
 #include "core/config/config.h"
 #include "core/geometry/se3.h"
 #include "render/gpu_mesh.h"
-#include "render/mesh.h"
+#include "core/scene/mesh.h"
 
 namespace arpipe {
 

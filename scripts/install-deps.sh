@@ -11,7 +11,7 @@ packages=(
   libtomlplusplus-dev nlohmann-json3-dev libsystemd-dev libfmt-dev
   # render: EGL + GLES 3 on Mesa (llvmpipe when there is no GPU)
   libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri libgbm1
-  libtinygltf-dev libstb-dev libpng-dev
+  libtinygltf-dev libembree-dev libstb-dev libpng-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev librapidcheck-dev libbenchmark-dev
   # mrcal's own tools: tests check our camera model against them

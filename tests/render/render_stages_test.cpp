@@ -13,7 +13,7 @@
 
 #include "core/image/pixel_convert.h"
 #include "render/render_errors.h"
-#include "gltf_test_files.h"
+#include "tests/scene/gltf_test_files.h"
 #include "render_test_support.h"
 
 namespace arpipe {

@@ -2,7 +2,7 @@
 // base on z = 0, centred on the object origin in x and y, about 6 cm across.
 #pragma once
 
-#include "render/mesh.h"
+#include "core/scene/mesh.h"
 
 namespace arpipe {
 

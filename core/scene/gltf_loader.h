@@ -4,7 +4,7 @@
 
 #include <filesystem>
 
-#include "render/mesh.h"
+#include "core/scene/mesh.h"
 
 namespace arpipe {
 

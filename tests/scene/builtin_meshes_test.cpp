@@ -1,6 +1,6 @@
 // Tests of the procedural meshes: size and placement (base on z = 0, centred in x and y), outward
 // normals and winding, and a closed surface (every edge shared by exactly two triangles).
-#include "render/builtin_meshes.h"
+#include "core/scene/builtin_meshes.h"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // Loads the triangle meshes of a glTF 2.0 file (.gltf or .glb, via tinygltf) into one Mesh, with
 // node transforms applied and glTF's y-up axes turned into arpipe's z-up object frame.
-#include "render/gltf_loader.h"
+#include "core/scene/gltf_loader.h"
 
 // The one translation unit that compiles tinygltf. Images are never decoded (the renderer uses
 // base colours only), so stb is left out: no image decoder in the process and no clash with
@@ -25,7 +25,7 @@
 #include <set>
 
 #include "core/log.h"
-#include "render/render_errors.h"
+#include "core/scene/asset_error.h"
 
 namespace arpipe {
 namespace {

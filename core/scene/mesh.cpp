@@ -1,6 +1,6 @@
 // A triangle mesh in an object's own frame (metres, z up): what the loaders produce and the GPU
 // upload consumes. Parts share the vertex arrays and differ in base colour.
-#include "render/mesh.h"
+#include "core/scene/mesh.h"
 
 #include <algorithm>
 

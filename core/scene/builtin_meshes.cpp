@@ -1,6 +1,6 @@
 // The procedural meshes a scene can name without a file ("builtin:cube", "builtin:pyramid"):
 // base on z = 0, centred on the object origin in x and y, about 6 cm across.
-#include "render/builtin_meshes.h"
+#include "core/scene/builtin_meshes.h"
 
 namespace arpipe {
 namespace {

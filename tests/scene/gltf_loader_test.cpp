@@ -1,7 +1,7 @@
 // Tests of the glTF loader on small glTF 2.0 files written here (buffers embedded as base64 data
 // URIs): vertex count, bounds after node transform and axis turn, colours, and every error case
 // naming the file.
-#include "render/gltf_loader.h"
+#include "core/scene/gltf_loader.h"
 
 #include <gtest/gtest.h>
 
@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "gltf_test_files.h"
-#include "render/render_errors.h"
+#include "tests/scene/gltf_test_files.h"
+#include "core/scene/asset_error.h"
 
 namespace arpipe {
 namespace {
