@@ -73,12 +73,13 @@ std::string get_string(const json& object, const char* name, const std::string& 
 }
 
 // A part's name must stay inside the recording directory.
-std::string get_file_name(const json& files, const char* name, const std::string& where) {
+// prefix: how messages name the object holding the key ("files." for recording.json's files).
+std::string get_file_name(const json& files, const char* name, const std::string& where, const char* prefix = "files.") {
   const char* expected = "a plain file name inside the recording directory";
   std::string value = get_string(files, name, where, expected);
   if (value.empty() || value == "." || value == ".." || value.find('/') != std::string::npos ||
       value.find('\0') != std::string::npos)
-    throw RecordingError(fmt::format("{}: files.{} is \"{}\", expected {}", where, name, value, expected));
+    throw RecordingError(fmt::format("{}: {}{} is \"{}\", expected {}", where, prefix, name, value, expected));
   return value;
 }
 
@@ -106,6 +107,43 @@ SE3 get_pose(const json& object, const char* name, const std::string& where) {
   if (!value.is_object()) wrong_type(name, value, where, expected);
   const std::string inner = fmt::format("{} (in \"{}\")", where, name);
   return SE3::from_rt(get_vec3(value, "r", inner), get_vec3(value, "t", inner));
+}
+
+constexpr double kDegreesPerRadian = 180.0 / 3.14159265358979323846;
+
+json light_json(const GroundTruthLight& light) {
+  nlohmann::ordered_json j = {{"name", light.name}, {"kind", light.kind}};
+  if (light.kind == "directional") {
+    j["direction_to_light"] = vec3_json(light.direction_to_light);
+    j["irradiance"] = light.strength;
+    j["angular_diameter_deg"] = light.angular_diameter_rad * kDegreesPerRadian;
+  } else {
+    j["position"] = vec3_json(light.position);
+    j["intensity"] = light.strength;
+    if (light.kind == "sphere") j["radius_m"] = light.radius_m;
+  }
+  j["color"] = json::array({light.color[0], light.color[1], light.color[2]});
+  return j;
+}
+
+GroundTruthLight get_light(const json& object, const std::string& where) {
+  if (!object.is_object()) wrong_type("lights", object, where, "a light object");
+  GroundTruthLight light;
+  light.name = get_string(object, "name", where, "the light's name");
+  light.kind = get_string(object, "kind", where, "\"directional\", \"point\" or \"sphere\"");
+  if (light.kind == "directional") {
+    light.direction_to_light = get_vec3(object, "direction_to_light", where);
+    light.strength = get_double(object, "irradiance", where, "irradiance in W/m^2");
+    light.angular_diameter_rad = get_double(object, "angular_diameter_deg", where, "degrees") / kDegreesPerRadian;
+  } else if (light.kind == "point" || light.kind == "sphere") {
+    light.position = get_vec3(object, "position", where);
+    light.strength = get_double(object, "intensity", where, "intensity in W/sr");
+    if (light.kind == "sphere") light.radius_m = get_double(object, "radius_m", where, "the radius in metres");
+  } else {
+    throw RecordingError(fmt::format("{}: kind is \"{}\", expected \"directional\", \"point\" or \"sphere\"", where, light.kind));
+  }
+  light.color = get_vec3(object, "color", where);
+  return light;
 }
 
 }  // namespace
@@ -215,24 +253,74 @@ FrameRecord decode_frame_record(const std::string& line, const std::string& wher
 }
 
 std::string encode_ground_truth(const GroundTruthRecord& r) {
+  const GroundTruthFrame& t = r.truth;
   nlohmann::ordered_json j = {
       {"index", r.index},
-      {"sequence", r.truth.sequence},
-      {"T_cam_world_start", pose_json(r.truth.T_cam_world_start)},
-      {"T_cam_world_mid", pose_json(r.truth.T_cam_world_mid)},
-      {"T_cam_world_end", pose_json(r.truth.T_cam_world_end)},
+      {"sequence", t.sequence},
+      {"T_cam_world_start", pose_json(t.T_cam_world_start)},
+      {"T_cam_world_mid", pose_json(t.T_cam_world_mid)},
+      {"T_cam_world_end", pose_json(t.T_cam_world_end)},
   };
+  if (t.exposure_ns > 0) {
+    j["exposure_ns"] = t.exposure_ns;
+    j["analogue_gain"] = t.analogue_gain;
+    j["digital_gain"] = t.digital_gain;
+  }
+  if (!t.rows.empty()) {
+    json rows = json::array();
+    for (const GroundTruthRowPose& row : t.rows) rows.push_back({{"row", row.row}, {"T_cam_world", pose_json(row.T_cam_world)}});
+    j["rows"] = rows;
+  }
+  if (!t.lights.empty()) {
+    json lights = json::array();
+    for (const GroundTruthLight& light : t.lights) lights.push_back(light_json(light));
+    j["lights"] = lights;
+  }
+  if (t.sun)
+    j["sun"] = {{"azimuth_deg", t.sun->azimuth_rad * kDegreesPerRadian},
+                {"elevation_deg", t.sun->elevation_rad * kDegreesPerRadian}};
+  if (!t.linear_image.empty()) j["linear_image"] = t.linear_image;
   return j.dump();
 }
 
 GroundTruthRecord decode_ground_truth(const std::string& line, const std::string& where) {
   const json j = parse_object(line, where, "one frame's ground truth", true);
   GroundTruthRecord r;
+  GroundTruthFrame& t = r.truth;
   r.index = get_unsigned(j, "index", where, "the frame index, counting from 0");
-  r.truth.sequence = get_unsigned(j, "sequence", where, "the frame's sequence number");
-  r.truth.T_cam_world_start = get_pose(j, "T_cam_world_start", where);
-  r.truth.T_cam_world_mid = get_pose(j, "T_cam_world_mid", where);
-  r.truth.T_cam_world_end = get_pose(j, "T_cam_world_end", where);
+  t.sequence = get_unsigned(j, "sequence", where, "the frame's sequence number");
+  t.T_cam_world_start = get_pose(j, "T_cam_world_start", where);
+  t.T_cam_world_mid = get_pose(j, "T_cam_world_mid", where);
+  t.T_cam_world_end = get_pose(j, "T_cam_world_end", where);
+  if (j.contains("exposure_ns")) {
+    t.exposure_ns = get_signed(j, "exposure_ns", where, "the exposure used, in ns");
+    t.analogue_gain = get_double(j, "analogue_gain", where, "the analogue gain used");
+    t.digital_gain = get_double(j, "digital_gain", where, "the digital gain used");
+  }
+  if (j.contains("rows")) {
+    const json& rows = j["rows"];
+    if (!rows.is_array()) wrong_type("rows", rows, where, "an array of {\"row\", \"T_cam_world\"}");
+    for (size_t i = 0; i < rows.size(); ++i) {
+      const std::string inner = fmt::format("{} (in \"rows\"[{}])", where, i);
+      if (!rows[i].is_object()) wrong_type("rows", rows[i], inner, "an object {\"row\", \"T_cam_world\"}");
+      t.rows.push_back({get_int(rows[i], "row", inner, "a row number"), get_pose(rows[i], "T_cam_world", inner)});
+    }
+  }
+  if (j.contains("lights")) {
+    const json& lights = j["lights"];
+    if (!lights.is_array()) wrong_type("lights", lights, where, "an array of light objects");
+    for (size_t i = 0; i < lights.size(); ++i)
+      t.lights.push_back(get_light(lights[i], fmt::format("{} (in \"lights\"[{}])", where, i)));
+  }
+  if (j.contains("sun")) {
+    const json& sun = j["sun"];
+    const std::string inner = fmt::format("{} (in \"sun\")", where);
+    if (!sun.is_object()) wrong_type("sun", sun, where, "an object {\"azimuth_deg\", \"elevation_deg\"}");
+    t.sun = GroundTruthSun{get_double(sun, "azimuth_deg", inner, "degrees east of north") / kDegreesPerRadian,
+                           get_double(sun, "elevation_deg", inner, "degrees above the horizon") / kDegreesPerRadian};
+  }
+  if (j.contains("linear_image"))
+    t.linear_image = get_file_name(j, "linear_image", where, "");
   return r;
 }
 

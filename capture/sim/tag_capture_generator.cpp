@@ -349,8 +349,11 @@ std::vector<GroundTruthFrame> tag_capture_ground_truth(const TagCaptureOptions& 
     const FrameMetadata m = frame_metadata(options, i);
     const bool looking_away = i >= options.frames - options.look_away_frames;
     auto pose_at = [&](int64_t t_ns) { return camera_pose(double(t_ns - kFirstExposureStartNs) * 1e-9, looking_away); };
-    truth.push_back({m.sequence, pose_at(m.exposure_start_ns), pose_at(m.exposure_mid_ns()),
-                     pose_at(m.exposure_start_ns + m.exposure_ns + m.readout_ns)});
+    GroundTruthFrame& frame_truth = truth.emplace_back();
+    frame_truth.sequence = m.sequence;
+    frame_truth.T_cam_world_start = pose_at(m.exposure_start_ns);
+    frame_truth.T_cam_world_mid = pose_at(m.exposure_mid_ns());
+    frame_truth.T_cam_world_end = pose_at(m.exposure_start_ns + m.exposure_ns + m.readout_ns);
   }
   return truth;
 }

@@ -64,9 +64,12 @@ inline Frame random_frame(PixelFormat format, int width, int height, size_t byte
 
 inline GroundTruthFrame truth_for(const Frame& f, uint64_t index) {
   const double k = double(index);
-  return {f.meta.sequence, SE3::from_rt({0.1 + 0.01 * k, -0.2, 0.3}, {0.01 * k, 0.02, 0.5}),
-          SE3::from_rt({0.1 + 0.011 * k, -0.2, 0.3}, {0.011 * k, 0.02, 0.5}),
-          SE3::from_rt({0.1 + 0.012 * k, -0.2, 0.3}, {0.012 * k, 0.02, 0.5})};
+  GroundTruthFrame truth;
+  truth.sequence = f.meta.sequence;
+  truth.T_cam_world_start = SE3::from_rt({0.1 + 0.01 * k, -0.2, 0.3}, {0.01 * k, 0.02, 0.5});
+  truth.T_cam_world_mid = SE3::from_rt({0.1 + 0.011 * k, -0.2, 0.3}, {0.011 * k, 0.02, 0.5});
+  truth.T_cam_world_end = SE3::from_rt({0.1 + 0.012 * k, -0.2, 0.3}, {0.012 * k, 0.02, 0.5});
+  return truth;
 }
 
 // Writes a recording of `count` random frames (with ground truth when asked) and returns its info.

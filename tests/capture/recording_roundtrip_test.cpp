@@ -202,5 +202,44 @@ TEST(RecordingWriter, RefusesAnInvalidImageSize) {
   EXPECT_NE(message.find("NV12 needs an even width"), std::string::npos) << message;
 }
 
+// The simulator's extra ground truth (rows, lights, sun, exposure, linear image) comes back as written.
+TEST(RecordingWriter, SimulatorGroundTruthRoundTrips) {
+  const fs::path dir = scratch_dir("truth-extra");
+  const RecordingInfo info{kRecordingFormatVersion, PixelFormat::GREY, 8, 4, 0, "test", ""};
+  {
+    RecordingWriter writer(dir, info, CameraModel::pinhole(10, 10, 3.5, 1.5, 8, 4));
+    const Frame f = random_frame(PixelFormat::GREY, 8, 4, writer.info().bytes_per_line, 0);
+    GroundTruthFrame truth = truth_for(f, 0);
+    truth.rows = {{0, SE3::from_rt({0.1, 0.2, 0.3}, {1, 2, 3})}, {3, SE3::from_rt({0.1, 0.2, 0.31}, {1, 2, 3.5})}};
+    truth.lights = {{"sun", "directional", {0.0, -0.6, 0.8}, {0, 0, 0}, {1.0, 0.9, 0.8}, 900.0, 0.00925, 0.0},
+                    {"lamp", "sphere", {0, 0, 0}, {0.5, -0.25, 1.5}, {1, 1, 1}, 12.5, 0.0, 0.05},
+                    {"bulb", "point", {0, 0, 0}, {0.1, 0.2, 0.3}, {0.5, 0.5, 1}, 3.0, 0.0, 0.0}};
+    truth.sun = GroundTruthSun{3.3919, 0.6959};
+    truth.exposure_ns = 7'654'321;
+    truth.analogue_gain = 2.5;
+    truth.digital_gain = 1.25;
+    truth.linear_image = "linear_000000.pfm";
+    writer.append(f, truth);
+  }
+  const RecordingReader reader(dir);
+  ASSERT_EQ(reader.ground_truth().size(), 1u);
+  const GroundTruthFrame& back = reader.ground_truth()[0];
+  ASSERT_EQ(back.rows.size(), 2u);
+  EXPECT_EQ(back.rows[1].row, 3);
+  expect_same_pose(back.rows[1].T_cam_world, SE3::from_rt({0.1, 0.2, 0.31}, {1, 2, 3.5}));
+  ASSERT_EQ(back.lights.size(), 3u);
+  EXPECT_EQ(back.lights[1], (GroundTruthLight{"lamp", "sphere", {0, 0, 0}, {0.5, -0.25, 1.5}, {1, 1, 1}, 12.5, 0.0, 0.05}));
+  EXPECT_EQ(back.lights[2].kind, "point");
+  // Angles pass through degrees in the file: a few ulps.
+  EXPECT_NEAR(back.lights[0].angular_diameter_rad, 0.00925, 1e-15);
+  ASSERT_TRUE(back.sun.has_value());
+  EXPECT_NEAR(back.sun->azimuth_rad, 3.3919, 1e-14);
+  EXPECT_NEAR(back.sun->elevation_rad, 0.6959, 1e-14);
+  EXPECT_EQ(back.exposure_ns, 7'654'321);
+  EXPECT_EQ(back.analogue_gain, 2.5);
+  EXPECT_EQ(back.digital_gain, 1.25);
+  EXPECT_EQ(back.linear_image, "linear_000000.pfm");
+}
+
 }  // namespace
 }  // namespace arpipe
