@@ -1,4 +1,4 @@
-// arpipe: the utility beside the daemon: inspect and replay recordings, generate captures, check configs.
+// arpipe: the utility beside the daemon: inspect and replay recordings, simulate and generate captures, check configs.
 #include <cstdio>
 #include <string>
 
@@ -13,6 +13,9 @@ commands:
   inspect DIR                        summary of a recording: frames, format, timing, drops
   replay DIR [--config FILE] [--set KEY=VALUE]...
                                      run the pipeline on a recording as fast as possible
+  simulate --scene FILE --out DIR [--frames N] [--seed S] [--threads N] [--samples N]
+                                     render a simulator scene (configs/sim/) into a
+                                     recording with exact ground truth
   generate --out DIR [--frames N] [--format GREY|RGB24|YUYV|NV12] [--seed S]
                                      write a capture of a camera moving over an AprilTag,
                                      with exact ground truth
@@ -32,6 +35,7 @@ int main(int argc, char** argv) {
   const arpipe::Args args(argv + 2, argv + argc);
   if (command == "inspect") return arpipe::run_inspect(args);
   if (command == "replay") return arpipe::run_replay(args);
+  if (command == "simulate") return arpipe::run_simulate(args);
   if (command == "generate") return arpipe::run_generate(args);
   if (command == "config") return arpipe::run_config(args);
   std::fprintf(stderr, "arpipe: unknown command '%s'\n%s", command.c_str(), kUsage);

@@ -1,0 +1,46 @@
+// Renders one simulated frame's radiance: per pixel, stratified samples over the pixel's area and
+// over its own row's exposure window (motion blur and rolling shutter), shaded by a SceneShader.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "capture/sim/camera_ray_grid.h"
+#include "capture/sim/camera_trajectory.h"
+#include "capture/sim/scene_shader.h"
+#include "core/frame.h"
+
+namespace arpipe::sim {
+
+// Mean linear radiance per pixel, RGB interleaved, row-major.
+struct RadianceImage {
+  int width = 0;
+  int height = 0;
+  std::vector<float> rgb;
+};
+
+// Random-number streams of one pixel of one frame: independent per purpose, so the sensor noise
+// of a pixel is the same whichever shader (with or without virtual objects) lit it.
+enum class SampleStream : uint64_t { Shading = 0, SensorNoise = 1 };
+uint64_t sample_stream(uint64_t frame_index, uint64_t pixel_index, SampleStream purpose);
+
+class FrameRenderer {
+ public:
+  // samples_per_pixel must be a square; threads: 0 for one per core.
+  FrameRenderer(const CameraRayGrid& rays, int width, int height, int samples_per_pixel, uint64_t seed, int threads = 0);
+
+  // trajectory_time_s: the trajectory's time at meta.exposure_start_ns.
+  void render(const SceneShader& shader, const CameraTrajectory& trajectory, const FrameMetadata& meta,
+              double trajectory_time_s, uint64_t frame_index, RadianceImage& out) const;
+
+ private:
+  const CameraRayGrid& rays_;
+  int width_;
+  int height_;
+  int samples_per_pixel_;
+  int samples_per_axis_;
+  uint64_t seed_;
+  int threads_;
+};
+
+}  // namespace arpipe::sim

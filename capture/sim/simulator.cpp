@@ -1,0 +1,214 @@
+// simulate(): the frame loop. Per frame: exposure setting → metadata → radiance (camera scene, and
+// the scene with virtual objects for the composite) → sensor → recording, ground truth, linear image.
+#include "capture/sim/simulator.h"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <stdexcept>
+
+#include "capture/recording/recording_writer.h"
+#include "capture/sim/camera_ray_grid.h"
+#include "capture/sim/camera_trajectory.h"
+#include "capture/sim/exposure_control.h"
+#include "capture/sim/frame_renderer.h"
+#include "capture/sim/scene_shader.h"
+#include "capture/sim/sensor_model.h"
+#include "core/image/pixel_convert.h"
+
+namespace arpipe::sim {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr int kGroundTruthRowStride = 16;  // rolling shutter: a pose every 16 rows, and the last row
+
+double trajectory_time_s(const SimCamera& camera, int64_t time_ns) {
+  return double(time_ns - camera.first_exposure_start_ns) * 1e-9;
+}
+
+std::vector<GroundTruthLight> ground_truth_lights(const SimScene& scene) {
+  std::vector<GroundTruthLight> lights;
+  for (const SimLight& light : scene.lights) {
+    GroundTruthLight& out = lights.emplace_back();
+    out.name = light.name;
+    out.color = light.color;
+    switch (light.kind) {
+      case SimLight::Kind::Directional:
+        out.kind = "directional";
+        out.direction_to_light = light.direction_to_light;
+        out.strength = light.irradiance;
+        out.angular_diameter_rad = light.angular_diameter_rad;
+        break;
+      case SimLight::Kind::Point:
+        out.kind = "point";
+        out.position = light.position;
+        out.strength = light.intensity;
+        break;
+      case SimLight::Kind::Sphere:
+        out.kind = "sphere";
+        out.position = light.position;
+        out.strength = light.intensity;
+        out.radius_m = light.radius_m;
+        break;
+    }
+  }
+  return lights;
+}
+
+GroundTruthFrame ground_truth(const SimScene& scene, const CameraTrajectory& trajectory, const FrameMetadata& meta,
+                              const std::vector<GroundTruthLight>& lights) {
+  const SimCamera& camera = scene.camera;
+  const double start = trajectory_time_s(camera, meta.exposure_start_ns);
+  GroundTruthFrame truth;
+  truth.sequence = meta.sequence;
+  truth.T_cam_world_start = trajectory.T_cam_world(start);
+  truth.T_cam_world_mid = trajectory.T_cam_world(trajectory_time_s(camera, meta.exposure_mid_ns()));
+  truth.T_cam_world_end = trajectory.T_cam_world(start + (meta.exposure_ns + meta.readout_ns) * 1e-9);
+  if (meta.readout_ns > 0) {
+    const int height = camera.model.height();
+    for (int row = 0; row < height; row = (row + kGroundTruthRowStride < height || row == height - 1)
+                                                ? row + kGroundTruthRowStride
+                                                : height - 1) {
+      const double mid = start + row_exposure_start_s(meta, row, height) + meta.exposure_ns * 0.5e-9;
+      truth.rows.push_back({row, trajectory.T_cam_world(mid)});
+      if (row == height - 1) break;
+    }
+  }
+  truth.lights = lights;
+  if (scene.sun) truth.sun = GroundTruthSun{scene.sun->azimuth_rad, scene.sun->elevation_rad};
+  truth.exposure_ns = meta.exposure_ns;
+  truth.analogue_gain = meta.analogue_gain;
+  truth.digital_gain = meta.digital_gain;
+  return truth;
+}
+
+// The sensor's output of a radiance image, as packed RGB24; noise from each pixel's own stream.
+std::vector<uint8_t> expose(const RadianceImage& radiance, const SensorModel& sensor, const SensorExposure& exposure,
+                            uint64_t seed, uint64_t frame_index) {
+  std::vector<uint8_t> rgb(radiance.rgb.size());
+  const size_t pixels = size_t(radiance.width) * radiance.height;
+  for (size_t p = 0; p < pixels; ++p) {
+    SampleRng rng(seed, sample_stream(frame_index, p, SampleStream::SensorNoise));
+    for (size_t c = 0; c < 3; ++c)
+      rgb[p * 3 + c] = SensorModel::quantize(sensor.encode(sensor.noisy_value(radiance.rgb[p * 3 + c], exposure, rng)));
+  }
+  return rgb;
+}
+
+// Mean noise-free linear value (after gains, before clipping): what auto-exposure meters.
+double mean_linear_value(const RadianceImage& radiance, const SensorModel& sensor, const SensorExposure& exposure) {
+  double sum = 0;
+  for (float value : radiance.rgb) sum += sensor.expected_value(value, exposure);
+  return radiance.rgb.empty() ? 0.0 : sum / double(radiance.rgb.size());
+}
+
+// The noise-free linear image as float RGB PFM (1.0 = full scale).
+void write_linear_image(const fs::path& path, const RadianceImage& radiance, const SensorModel& sensor,
+                        const SensorExposure& exposure) {
+  cv::Mat image(radiance.height, radiance.width, CV_32FC3);
+  for (int y = 0; y < radiance.height; ++y)
+    for (int x = 0; x < radiance.width; ++x) {
+      const size_t p = (size_t(y) * radiance.width + x) * 3;
+      // OpenCV images are BGR.
+      image.at<cv::Vec3f>(y, x) = cv::Vec3f(float(sensor.expected_value(radiance.rgb[p + 2], exposure)),
+                                            float(sensor.expected_value(radiance.rgb[p + 1], exposure)),
+                                            float(sensor.expected_value(radiance.rgb[p], exposure)));
+    }
+  bool written = false;
+  try {
+    written = cv::imwrite(path.string(), image);
+  } catch (const cv::Exception& e) {
+    throw RecordingError(fmt::format("{}: cannot write the linear image: {}", path.string(), e.what()));
+  }
+  if (!written) throw RecordingError(fmt::format("{}: cannot write the linear image", path.string()));
+}
+
+Frame to_frame(const std::vector<uint8_t>& rgb, int width, int height, PixelFormat format, const FrameMetadata& meta) {
+  Frame frame = from_rgb24(rgb.data(), width, height, format);
+  frame.meta = meta;
+  return frame;
+}
+
+}  // namespace
+
+SimulateSummary simulate(const SimScene& scene, const SimulateOptions& options) {
+  const auto started = std::chrono::steady_clock::now();
+  const SimCamera& camera = scene.camera;
+  const int frames = options.frames > 0 ? options.frames : scene.render.frames;
+  if (frames <= 0) throw std::invalid_argument(fmt::format("simulate: frames must be positive, got {}", frames));
+  const uint64_t seed = options.seed.value_or(scene.render.seed);
+  const int width = camera.model.width(), height = camera.model.height();
+
+  int64_t longest_exposure_ns = 0;
+  for (int64_t e : camera.exposure_ns) longest_exposure_ns = std::max(longest_exposure_ns, e);
+  const double duration_s = frames / camera.fps + (longest_exposure_ns + camera.readout_ns) * 1e-9;
+  const CameraTrajectory trajectory(scene.trajectory, camera, duration_s, seed);
+  const SensorModel sensor(camera.sensor);
+  const CameraRayGrid rays(camera.model);
+  const FrameRenderer renderer(rays, width, height, scene.render.samples_per_pixel, seed, options.threads);
+  const SceneShader camera_world(scene, false);
+  std::optional<SceneShader> composite_world;
+  if (scene.has_virtual_objects()) composite_world.emplace(scene, true);
+
+  const std::string source = options.source_description.empty()
+                                 ? fmt::format("arpipe simulate {} (seed {})", scene.source_file.string(), seed)
+                                 : options.source_description;
+  RecordingWriter writer(options.out_dir, RecordingInfo{kRecordingFormatVersion, camera.pixel_format, width, height, 0,
+                                                        source, ""},
+                         camera.model);
+  std::optional<RecordingWriter> composite_writer;
+  if (composite_world)
+    composite_writer.emplace(options.out_dir / kGroundTruthCompositeDir,
+                             RecordingInfo{kRecordingFormatVersion, PixelFormat::RGB24, width, height, 0,
+                                           source + ": ground-truth composite", ""},
+                             camera.model);
+  if (!scene.source_file.empty() && fs::is_regular_file(scene.source_file)) {
+    std::error_code ignored;  // a copy for reproducibility; the recording does not need it
+    fs::copy_file(scene.source_file, options.out_dir / kSceneCopyFile, fs::copy_options::overwrite_existing, ignored);
+  }
+
+  const std::vector<GroundTruthLight> lights = ground_truth_lights(scene);
+  ExposureControl exposure_control(camera);
+  RadianceImage radiance, composite_radiance;
+  for (int k = 0; k < frames; ++k) {
+    const auto index = uint64_t(k);
+    const ExposureSetting setting = exposure_control.setting(index);
+    const FrameMetadata meta = simulated_frame_metadata(camera, index, setting);
+    const SensorExposure exposure{meta.exposure_ns * 1e-9, meta.analogue_gain, meta.digital_gain};
+    const double start_s = trajectory_time_s(camera, meta.exposure_start_ns);
+
+    renderer.render(camera_world, trajectory, meta, start_s, index, radiance);
+    GroundTruthFrame truth = ground_truth(scene, trajectory, meta, lights);
+    if (scene.render.write_linear) {
+      truth.linear_image = fmt::format("linear_{:06d}.pfm", k);
+      write_linear_image(options.out_dir / truth.linear_image, radiance, sensor, exposure);
+    }
+    writer.append(to_frame(expose(radiance, sensor, exposure, seed, index), width, height, camera.pixel_format, meta),
+                  truth);
+    if (composite_world) {
+      renderer.render(*composite_world, trajectory, meta, start_s, index, composite_radiance);
+      composite_writer->append(
+          to_frame(expose(composite_radiance, sensor, exposure, seed, index), width, height, PixelFormat::RGB24, meta),
+          truth);
+    }
+    exposure_control.update(mean_linear_value(radiance, sensor, exposure));
+    if (options.on_frame) options.on_frame(k + 1, frames);
+  }
+  writer.flush();
+  if (composite_writer) composite_writer->flush();
+
+  SimulateSummary summary;
+  summary.frames = frames;
+  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  summary.wrote_composite = composite_world.has_value();
+  summary.ray_grid_error_px = rays.measured_error_px();
+  return summary;
+}
+
+}  // namespace arpipe::sim

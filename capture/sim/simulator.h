@@ -1,0 +1,41 @@
+// `arpipe simulate`: renders a scene into a format-v1 recording with its ground truth, plus the
+// ground-truth composite when the scene has virtual objects (docs/SIMULATOR.md).
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "capture/sim/sim_scene.h"
+
+namespace arpipe::sim {
+
+// The ground-truth composite's recording, inside the output directory.
+inline constexpr const char* kGroundTruthCompositeDir = "ground_truth_composite";
+// The scene file as simulated, copied into the output directory.
+inline constexpr const char* kSceneCopyFile = "scene.toml";
+
+struct SimulateOptions {
+  std::filesystem::path out_dir;   // must not hold a recording
+  int frames = 0;                  // 0: the scene's render.frames
+  std::optional<uint64_t> seed;    // default: the scene's render.seed
+  int threads = 0;                 // 0: one per core
+  std::string source_description;  // recording.json "source"; default: "arpipe simulate <scene>"
+  // Called after each frame is written: (frames done, frames in all).
+  std::function<void(int, int)> on_frame;
+};
+
+struct SimulateSummary {
+  int frames = 0;
+  double seconds = 0;          // wall time of rendering and writing
+  bool wrote_composite = false;
+  double ray_grid_error_px = 0;  // the camera ray grid's measured interpolation error
+};
+
+// Throws AssetError (a scene asset), RecordingError (writing), std::invalid_argument (options).
+// Frames written before an error stay readable.
+SimulateSummary simulate(const SimScene& scene, const SimulateOptions& options);
+
+}  // namespace arpipe::sim
