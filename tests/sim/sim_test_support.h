@@ -1,0 +1,67 @@
+// Shared by the simulator's end-to-end tests: scratch directories, small scenes built in code
+// (independent of the scene-file loader) and reading images back.
+#pragma once
+
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <string>
+
+#include "capture/sim/sim_scene.h"
+
+namespace arpipe::sim::test {
+
+namespace fs = std::filesystem;
+
+inline fs::path scratch_dir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / fmt::format("arpipe-sim-test-{}-{}", getpid(), name);
+  fs::remove_all(dir);
+  return dir;
+}
+
+// A noise-free, linear-response camera with a pinhole lens; renders in RGB24.
+inline SimCamera exact_camera(int width, int height, double focal_px) {
+  SimCamera camera;
+  camera.model = CameraModel::pinhole(focal_px, focal_px, (width - 1) / 2.0, (height - 1) / 2.0, width, height);
+  camera.pixel_format = PixelFormat::RGB24;
+  camera.sensor.noise = false;
+  camera.sensor.response = "linear";
+  return camera;
+}
+
+// A still camera at `position` looking at `look_at`, image up along world +y unless given.
+inline SimTrajectory still(const Vec3& position, const Vec3& look_at, const Vec3& up = {0, 1, 0}) {
+  SimTrajectory trajectory;
+  trajectory.kind = SimTrajectory::Kind::Keyframes;
+  trajectory.keyframes.push_back({0.0, position, look_at, up, 0.0});
+  return trajectory;
+}
+
+// A plane on the world xy plane (face up, +z), centred at the origin.
+inline SimObject ground_plane(const std::string& name, double width_m, double height_m, const SimTexture& texture = {}) {
+  SimObject plane;
+  plane.name = name;
+  plane.shape = SimObject::Shape::Plane;
+  plane.width_m = width_m;
+  plane.height_m = height_m;
+  plane.material.texture = texture;
+  return plane;
+}
+
+// One overhead directional light of irradiance E and zero angular diameter, and no sky.
+inline SimLight overhead_sun(double irradiance) {
+  SimLight light;
+  light.name = "overhead";
+  light.kind = SimLight::Kind::Directional;
+  light.direction_to_light = {0, 0, 1};
+  light.irradiance = irradiance;
+  return light;
+}
+
+// Reads a float RGB PFM written by the simulator (linear image), as OpenCV BGR.
+inline cv::Mat read_linear(const fs::path& path) { return cv::imread(path.string(), cv::IMREAD_UNCHANGED); }
+
+}  // namespace arpipe::sim::test
