@@ -110,6 +110,56 @@ TEST_F(ArpipeCli, GenerateRejectsBadOptions) {
   EXPECT_FALSE(fs::exists(dir_ / "x"));
 }
 
+// A scene from configs/sim rendered small and fast, then replayed: every frame comes out, the tag
+// is tracked, and the recording carries its ground truth and a copy of the scene.
+TEST_F(ArpipeCli, SimulateThenReplay) {
+  const fs::path capture = dir_ / "sim";
+  const fs::path scene = fs::path(ARPIPE_SOURCE_DIR) / "configs" / "sim" / "tag-static.toml";
+  std::string err;
+  ASSERT_EQ(run({"simulate", "--scene", scene.string(), "--out", capture.string(), "--frames", "3", "--samples", "1",
+                 "--seed", "11"},
+                nullptr, &err),
+            0)
+      << err;
+  EXPECT_NE(err.find("3/3 frames"), std::string::npos) << err;  // the progress report
+  RecordingReader reader(capture);
+  EXPECT_EQ(reader.frame_count(), 3u);
+  EXPECT_EQ(reader.ground_truth().size(), 3u);
+  EXPECT_TRUE(fs::exists(capture / "scene.toml"));
+  // Refuses to overwrite a recording.
+  EXPECT_EQ(run({"simulate", "--scene", scene.string(), "--out", capture.string()}, nullptr, &err), 1);
+  EXPECT_NE(err.find(capture.string()), std::string::npos) << err;
+
+  ASSERT_EQ(run({"replay", capture.string(), "--set", "sinks.png.enabled=false", "--set", "sinks.y4m.enabled=false",
+                 "--set", "sinks.results.path=\"" + (dir_ / "r.jsonl").string() + "\""},
+                nullptr, &err),
+            0)
+      << err;
+  std::ifstream results(dir_ / "r.jsonl");
+  size_t lines = 0, tracking = 0;
+  for (std::string line; std::getline(results, line);) {
+    ++lines;
+    if (line.find("\"track_state\":\"tracking\"") != std::string::npos) ++tracking;
+  }
+  EXPECT_EQ(lines, 3u);
+  EXPECT_EQ(tracking, 3u);
+}
+
+TEST_F(ArpipeCli, SimulateNamesTheBadSceneFileAndKey) {
+  std::ofstream(dir_ / "bad.toml") << "[camera]\nexposure_ms = 0\n";
+  std::string err;
+  EXPECT_EQ(run({"simulate", "--scene", (dir_ / "bad.toml").string(), "--out", (dir_ / "x").string()}, nullptr, &err),
+            2);
+  EXPECT_NE(err.find("bad.toml"), std::string::npos) << err;
+  EXPECT_NE(err.find("exposure_ms"), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(dir_ / "x"));
+  EXPECT_EQ(run({"simulate", "--scene", (dir_ / "bad.toml").string(), "--out", (dir_ / "x").string(), "--samples",
+                 "5"},
+                nullptr, &err),
+            2);
+  EXPECT_NE(err.find("--samples"), std::string::npos) << err;
+}
+
 TEST_F(ArpipeCli, ConfigDefaultsAreAValidConfigAndCheckNamesErrors) {
   std::string out, err;
   ASSERT_EQ(run({"config", "--defaults"}, &out, &err), 0) << err;

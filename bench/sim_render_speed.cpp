@@ -1,0 +1,115 @@
+// Benchmark: the simulator's run time against its Monte-Carlo error, per scene and samples per
+// pixel. Error = RMS difference of the noise-free linear image from a high-sample reference of the
+// same frame, relative to the reference's mean (so scenes of any brightness compare).
+// Usage: sim_render_speed [--scenes DIR] [--samples 1,4,16] [--reference 256] [--frames N] [--threads N]
+// Prints a markdown table for docs/BENCHMARKS.md.
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "capture/recording/recording_reader.h"
+#include "capture/sim/sim_scene_loader.h"
+#include "capture/sim/simulator.h"
+#include "core/log.h"
+
+using namespace arpipe;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Run {
+  double seconds_per_frame = 0;
+  std::vector<cv::Mat> linear;  // per frame
+};
+
+Run render(sim::SimScene scene, int samples, int frames, int threads, const fs::path& dir) {
+  fs::remove_all(dir);
+  scene.render.samples_per_pixel = samples;
+  scene.render.write_linear = true;
+  sim::SimulateOptions options;
+  options.out_dir = dir;
+  options.frames = frames;
+  options.threads = threads;
+  const sim::SimulateSummary summary = sim::simulate(scene, options);
+  Run run;
+  run.seconds_per_frame = summary.seconds / frames;
+  const RecordingReader reader(dir);
+  for (const GroundTruthFrame& truth : reader.ground_truth())
+    run.linear.push_back(cv::imread((dir / truth.linear_image).string(), cv::IMREAD_UNCHANGED));
+  fs::remove_all(dir);
+  return run;
+}
+
+double relative_rms(const std::vector<cv::Mat>& images, const std::vector<cv::Mat>& reference) {
+  double squared = 0, mean = 0, count = 0;
+  for (size_t i = 0; i < images.size(); ++i) {
+    cv::Mat difference = images[i] - reference[i];
+    squared += cv::sum(difference.mul(difference))[0] + cv::sum(difference.mul(difference))[1] +
+               cv::sum(difference.mul(difference))[2];
+    const cv::Scalar sum = cv::sum(reference[i]);
+    mean += sum[0] + sum[1] + sum[2];
+    count += double(reference[i].total()) * 3;
+  }
+  return std::sqrt(squared / count) / (mean / count);
+}
+
+std::vector<int> parse_list(const std::string& text) {
+  std::vector<int> values;
+  std::stringstream in(text);
+  for (std::string item; std::getline(in, item, ',');) values.push_back(std::stoi(item));
+  return values;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  log::set_program_name("sim_render_speed");
+  fs::path scenes_dir = "configs/sim";
+  std::vector<int> samples{1, 4, 16};
+  int reference_samples = 256, frames = 2, threads = 0;
+  for (int i = 1; i + 1 < argc; i += 2) {
+    const std::string key = argv[i], value = argv[i + 1];
+    if (key == "--scenes") scenes_dir = value;
+    else if (key == "--samples") samples = parse_list(value);
+    else if (key == "--reference") reference_samples = std::stoi(value);
+    else if (key == "--frames") frames = std::stoi(value);
+    else if (key == "--threads") threads = std::stoi(value);
+    else {
+      fmt::print(stderr, "unknown option {}\n", key);
+      return 2;
+    }
+  }
+  std::vector<fs::path> scene_files;
+  for (const auto& entry : fs::directory_iterator(scenes_dir))
+    if (entry.path().extension() == ".toml") scene_files.push_back(entry.path());
+  std::sort(scene_files.begin(), scene_files.end());
+
+  const fs::path scratch = fs::temp_directory_path() / fmt::format("arpipe-sim-bench-{}", getpid());
+  fmt::print("| scene | size | samples/px | s/frame | rel. RMS error vs {} spp | speed-up vs 16 spp |\n",
+             reference_samples);
+  fmt::print("|---|---|---|---|---|---|\n");
+  for (const fs::path& file : scene_files) {
+    const sim::SimScene scene = sim::load_sim_scene(file);
+    const Run reference = render(scene, reference_samples, frames, threads, scratch);
+    std::vector<std::pair<int, Run>> runs;
+    double sixteen = 0;
+    for (int n : samples) {
+      runs.emplace_back(n, render(scene, n, frames, threads, scratch));
+      if (n == 16) sixteen = runs.back().second.seconds_per_frame;
+    }
+    for (const auto& [n, run] : runs)
+      fmt::print("| {} | {}x{} | {} | {:.3f} | {:.4f} | {} |\n", file.stem().string(), scene.camera.model.width(),
+                 scene.camera.model.height(), n, run.seconds_per_frame, relative_rms(run.linear, reference.linear),
+                 sixteen > 0 ? fmt::format("{:.2f}", sixteen / run.seconds_per_frame) : "–");
+    std::fflush(stdout);
+  }
+  return 0;
+}
