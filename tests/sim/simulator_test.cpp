@@ -59,7 +59,7 @@ TEST(Simulator, ChessboardCornersLandWhereMrcalProjectsThem) {
   scene.objects.push_back(plane);
   scene.lights.push_back(overhead_sun(kPi));  // radiance = albedo
   scene.trajectory = still({0.06, -0.14, 0.36}, {0.0, 0.0, 0.0});
-  scene.render.samples_per_pixel = 16;
+  scene.render.samples_per_pixel = 64;
 
   const fs::path dir = scratch_dir("corners");
   SimulateOptions options;
@@ -72,7 +72,11 @@ TEST(Simulator, ChessboardCornersLandWhereMrcalProjectsThem) {
   const cv::Size pattern(board.cols - 1, board.rows - 1);
   std::vector<cv::Point2f> found;
   ASSERT_TRUE(cv::findChessboardCorners(grey, pattern, found, cv::CALIB_CB_ADAPTIVE_THRESH));
-  cv::cornerSubPix(grey, found, cv::Size(5, 5), cv::Size(-1, -1),
+  // cornerSubPix needs gradients across more than the one pixel a crisp edge has: a symmetric blur
+  // keeps an X-junction's saddle point where it is and gives it them.
+  cv::Mat smooth;
+  cv::GaussianBlur(grey, smooth, cv::Size(0, 0), 1.0);
+  cv::cornerSubPix(smooth, found, cv::Size(5, 5), cv::Size(-1, -1),
                    cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 100, 1e-4));
 
   // The true inner corners (plane frame = world frame here): columns from the left edge, rows
@@ -95,7 +99,9 @@ TEST(Simulator, ChessboardCornersLandWhereMrcalProjectsThem) {
     worst = std::max(worst, nearest);
     sum += nearest;
   }
-  // The budget: 0.1 px. cornerSubPix itself is good to a few hundredths on clean corners.
+  // The budget: 0.1 px for every corner. Measured: worst 0.06, mean 0.035, with no
+  // common offset; what is left is the detector's and 8-bit quantisation's own scatter (at 16
+  // samples per pixel the area-sampling noise on crisp edges doubles it, hence 64 here).
   EXPECT_LT(worst, 0.1);
   EXPECT_LT(sum / double(found.size()), 0.05);
 }
@@ -239,10 +245,21 @@ TEST(Simulator, NoMotionNoBlur) {
   options.frames = 4;
   simulate(edge.scene, options);
   const RecordingReader reader(dir);
-  const EdgeProfile profile = edge_profile(read_linear(dir / reader.ground_truth()[3].linear_image));
-  // A still edge: only the pixel footprint and the difference kernel, (0 + 2) / 12; allow the
-  // sub-pixel position's effect on a 16-sample estimate.
-  for (double v : profile.variance) EXPECT_NEAR(v, 2.0 / 12, 0.05);
+  const cv::Mat linear = read_linear(dir / reader.ground_truth()[3].linear_image);
+  // A still, crisp edge covers at most one pixel partly: every other pixel is pure ink or paper.
+  for (int y = 0; y < linear.rows; ++y) {
+    const double dark = linear.at<cv::Vec3f>(y, 0)[1], light = linear.at<cv::Vec3f>(y, linear.cols - 1)[1];
+    int mixed = 0;
+    for (int x = 0; x < linear.cols; ++x) {
+      const double s = (linear.at<cv::Vec3f>(y, x)[1] - dark) / (light - dark);
+      if (s > 1e-6 && s < 1 - 1e-6) ++mixed;
+    }
+    EXPECT_LE(mixed, 1) << "row " << y;
+  }
+  // And the edge is where the pinhole puts the world line x = 0 (plane at x = 0 here): the
+  // image centre column, to the sampling's precision (16 area samples: 1/16 px steps).
+  const EdgeProfile profile = edge_profile(linear);
+  for (double centre : profile.centre) EXPECT_NEAR(centre, (linear.cols - 1) / 2.0, 0.07);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -296,7 +313,7 @@ SimScene small_noisy_scene() {
   SimObject table = ground_plane("table", 2, 2);
   table.T_world_object = SE3(identity3(), {0, 0, -0.001});
   scene.objects.push_back(table);
-  SimLight sun = overhead_sun(800);
+  SimLight sun = overhead_sun(5);  // paper at ~0.5 of full scale: nothing clips
   sun.name = "sun";
   sun.is_sun = true;
   sun.direction_to_light = normalized(Vec3{0.3, -0.4, 0.866});
@@ -343,7 +360,7 @@ TEST(Simulator, GroundTruthHasPosesLightsSunAndExposure) {
   ASSERT_EQ(truth.lights.size(), 1u);
   EXPECT_EQ(truth.lights[0].kind, "directional");
   EXPECT_LT(norm(truth.lights[0].direction_to_light - scene.lights[0].direction_to_light), 1e-12);
-  EXPECT_NEAR(truth.lights[0].strength, 800, 1e-9);
+  EXPECT_EQ(truth.lights[0].strength, scene.lights[0].irradiance);
   ASSERT_TRUE(truth.sun.has_value());
   EXPECT_NEAR(truth.sun->azimuth_rad, 2.5, 1e-12);
   EXPECT_NEAR(truth.sun->elevation_rad, 1.05, 1e-12);
