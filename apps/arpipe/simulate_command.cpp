@@ -84,8 +84,9 @@ int run_simulate(const Args& args) {
   try {
     const sim::SimulateSummary summary = sim::simulate(scene, options);
     progress.finish();
-    log::info("wrote {} frames to {} in {:.1f} s ({:.2f} s per frame{})", summary.frames, options.out_dir.string(),
-              summary.seconds, summary.seconds / summary.frames,
+    log::info("wrote {} frames to {} in {:.1f} s ({:.1f} s setup, {:.2f} s per frame{})", summary.frames,
+              options.out_dir.string(), summary.seconds, summary.setup_seconds,
+              (summary.seconds - summary.setup_seconds) / summary.frames,
               summary.wrote_composite ? ", with the ground-truth composite" : "");
     return 0;
   } catch (const std::exception& e) {

@@ -173,6 +173,7 @@ SimulateSummary simulate(const SimScene& scene, const SimulateOptions& options) 
     fs::copy_file(scene.source_file, options.out_dir / kSceneCopyFile, fs::copy_options::overwrite_existing, ignored);
   }
 
+  const double setup_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   const std::vector<GroundTruthLight> lights = ground_truth_lights(scene);
   ExposureControl exposure_control(camera);
   RadianceImage radiance, composite_radiance;
@@ -206,6 +207,7 @@ SimulateSummary simulate(const SimScene& scene, const SimulateOptions& options) 
   SimulateSummary summary;
   summary.frames = frames;
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  summary.setup_seconds = setup_seconds;
   summary.wrote_composite = composite_world.has_value();
   summary.ray_grid_error_px = rays.measured_error_px();
   return summary;

@@ -2,6 +2,7 @@
 // (independent of the scene-file loader) and reading images back.
 #pragma once
 
+#include <fmt/format.h>
 #include <unistd.h>
 
 #include <cmath>
