@@ -1,6 +1,8 @@
 // Benchmark: the simulator's run time against its Monte-Carlo error, per scene and samples per
 // pixel. Error = RMS difference of the noise-free linear image from a high-sample reference of the
-// same frame, relative to the reference's mean (so scenes of any brightness compare).
+// same frame, both clipped at full scale as the sensor clips them (a light seen directly or in a
+// mirror is thousands of times full scale and would otherwise swamp everything), relative to the
+// reference's mean (so scenes of any brightness compare).
 // Usage: sim_render_speed [--scenes DIR] [--samples 1,4,16] [--reference 256] [--frames N] [--threads N]
 // Prints a markdown table for docs/BENCHMARKS.md.
 #include <fmt/format.h>
@@ -50,15 +52,16 @@ Run render(sim::SimScene scene, int samples, int frames, int threads, const fs::
   return run;
 }
 
-double relative_rms(const std::vector<cv::Mat>& images, const std::vector<cv::Mat>& reference) {
+double relative_rms(const std::vector<cv::Mat>& images, const std::vector<cv::Mat>& references) {
   double squared = 0, mean = 0, count = 0;
   for (size_t i = 0; i < images.size(); ++i) {
-    cv::Mat difference = images[i] - reference[i];
-    squared += cv::sum(difference.mul(difference))[0] + cv::sum(difference.mul(difference))[1] +
-               cv::sum(difference.mul(difference))[2];
-    const cv::Scalar sum = cv::sum(reference[i]);
+    const cv::Mat image = cv::min(images[i], 1.0), reference = cv::min(references[i], 1.0);
+    const cv::Mat difference = image - reference;
+    const cv::Scalar squares = cv::sum(difference.mul(difference));
+    squared += squares[0] + squares[1] + squares[2];
+    const cv::Scalar sum = cv::sum(reference);
     mean += sum[0] + sum[1] + sum[2];
-    count += double(reference[i].total()) * 3;
+    count += double(reference.total()) * 3;
   }
   return std::sqrt(squared / count) / (mean / count);
 }
