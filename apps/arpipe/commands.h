@@ -11,7 +11,6 @@ using Args = std::vector<std::string>;
 
 int run_inspect(const Args& args);   // arpipe inspect DIR
 int run_replay(const Args& args);    // arpipe replay DIR [--config FILE] [--set K=V]...
-int run_generate(const Args& args);  // arpipe generate --out DIR [--frames N] [--format F] [--seed S]
 int run_simulate(const Args& args);  // arpipe simulate --scene FILE --out DIR [--frames N] [--seed S] ...
 int run_config(const Args& args);    // arpipe config --defaults | --check FILE
 

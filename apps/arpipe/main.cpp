@@ -1,4 +1,4 @@
-// arpipe: the utility beside the daemon: inspect and replay recordings, simulate and generate captures, check configs.
+// arpipe: the utility beside the daemon: inspect and replay recordings, simulate captures, check configs.
 #include <cstdio>
 #include <string>
 
@@ -16,9 +16,6 @@ commands:
   simulate --scene FILE --out DIR [--frames N] [--seed S] [--threads N] [--samples N]
                                      render a simulator scene (configs/sim/) into a
                                      recording with exact ground truth
-  generate --out DIR [--frames N] [--format GREY|RGB24|YUYV|NV12] [--seed S]
-                                     write a capture of a camera moving over an AprilTag,
-                                     with exact ground truth
   config --defaults                  print a config with every key at its default
   config --check FILE                validate a config file
 )";
@@ -36,7 +33,6 @@ int main(int argc, char** argv) {
   if (command == "inspect") return arpipe::run_inspect(args);
   if (command == "replay") return arpipe::run_replay(args);
   if (command == "simulate") return arpipe::run_simulate(args);
-  if (command == "generate") return arpipe::run_generate(args);
   if (command == "config") return arpipe::run_config(args);
   std::fprintf(stderr, "arpipe: unknown command '%s'\n%s", command.c_str(), kUsage);
   return 2;

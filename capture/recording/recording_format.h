@@ -38,7 +38,7 @@ struct RecordingInfo {
   int width = 0;
   int height = 0;
   size_t bytes_per_line = 0;  // 0 when writing: the minimum for the format and width
-  std::string source;         // free text: "arpipe generate ...", "v4l2:/dev/video0", ...
+  std::string source;         // free text: "arpipe simulate ...", "v4l2:/dev/video0", ...
   std::string created_utc;    // ISO 8601, "2024-05-01T12:00:00Z"; empty when writing: now
 };
 

@@ -1,4 +1,4 @@
-// The `arpipe` utility as a person runs it: inspect, replay, generate, config; bad input exits 2
+// The `arpipe` utility as a person runs it: inspect, replay, simulate, config; bad input exits 2
 // with a message naming the file, never a crash.
 #include <gtest/gtest.h>
 
@@ -72,42 +72,6 @@ TEST_F(ArpipeCli, InspectOfAMissingRecordingNamesIt) {
   std::string err;
   EXPECT_EQ(run({"inspect", (dir_ / "nothing-here").string()}, nullptr, &err), 2);
   EXPECT_NE(err.find("nothing-here"), std::string::npos) << err;
-}
-
-TEST_F(ArpipeCli, GenerateThenReplay) {
-  const fs::path capture = dir_ / "small";
-  std::string err;
-  ASSERT_EQ(run({"generate", "--out", capture.string(), "--frames", "5", "--format", "NV12", "--seed", "7"}, nullptr,
-                &err),
-            0)
-      << err;
-  RecordingReader reader(capture);
-  EXPECT_EQ(reader.frame_count(), 5u);
-  EXPECT_EQ(reader.info().pixel_format, PixelFormat::NV12);
-  EXPECT_EQ(reader.ground_truth().size(), 5u);
-  // Refuses to overwrite a recording.
-  EXPECT_EQ(run({"generate", "--out", capture.string()}, nullptr, &err), 2);
-  EXPECT_NE(err.find(capture.string()), std::string::npos) << err;
-
-  ASSERT_EQ(run({"replay", capture.string(), "--set", "sinks.png.enabled=false", "--set",
-                 "sinks.y4m.path=\"" + (dir_ / "o.y4m").string() + "\"", "--set",
-                 "sinks.results.path=\"" + (dir_ / "r.jsonl").string() + "\""},
-                nullptr, &err),
-            0)
-      << err;
-  std::ifstream results(dir_ / "r.jsonl");
-  size_t lines = 0;
-  for (std::string line; std::getline(results, line);) ++lines;
-  EXPECT_EQ(lines, 5u);
-}
-
-TEST_F(ArpipeCli, GenerateRejectsBadOptions) {
-  std::string err;
-  EXPECT_EQ(run({"generate", "--out", (dir_ / "x").string(), "--format", "MJPG"}, nullptr, &err), 2);
-  EXPECT_NE(err.find("MJPG"), std::string::npos) << err;
-  EXPECT_EQ(run({"generate", "--out", (dir_ / "x").string(), "--frames", "-3"}, nullptr, &err), 2);
-  EXPECT_NE(err.find("-3"), std::string::npos) << err;
-  EXPECT_FALSE(fs::exists(dir_ / "x"));
 }
 
 // A scene from configs/sim rendered small and fast, then replayed: every frame comes out, the tag

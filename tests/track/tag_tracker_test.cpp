@@ -1,5 +1,5 @@
 // Tests of the TagTracker stage: configuration errors, the per-frame states (disabled, no model,
-// lost, tracking), and pose on a generated capture against its exact ground truth.
+// lost, tracking), and pose on simulated captures against their exact ground truth.
 #include "core/track/tag_tracker.h"
 
 #include <gtest/gtest.h>
@@ -10,7 +10,8 @@
 #include <string>
 
 #include "capture/recording/recording_reader.h"
-#include "capture/sim/tag_capture_generator.h"
+#include "capture/sim/sim_scene_loader.h"
+#include "capture/sim/simulator.h"
 #include "core/track/bundle_tag_geometry.h"
 
 namespace arpipe {
@@ -145,14 +146,35 @@ TEST(TagTrackerStates, MissingOrMismatchedCameraModelSkipsWithoutThrowing) {
   EXPECT_EQ(ctx.timings.at(0).skipped, "not configured");
 }
 
-// A scratch directory under the build tree for one generated capture, removed afterwards.
+// The embedded default capture, simulated by the build from configs/sim/default.toml: 60 frames of
+// a camera moving 0.45-0.55 m over a 10 cm tag36h11 (640x480, OPENCV4 lens, YUYV, sensor noise,
+// up to ~3 px of motion blur); the last 3 frames look away from the tag.
+const fs::path kDefaultCapture = fs::path(ARPIPE_BINARY_DIR) / "default-capture";
+
+// A scratch directory under the build tree holding the default scene's first frame, simulated at
+// another size and pixel format; removed afterwards.
 class ScratchCapture {
  public:
-  ScratchCapture(const std::string& name, const TagCaptureOptions& options)
+  ScratchCapture(const std::string& name, PixelFormat format, int width, int height)
       : dir_(fs::path(ARPIPE_BINARY_DIR) / "test-scratch" / "track" / (name + "-" + std::to_string(getpid()))) {
     fs::remove_all(dir_);
     fs::create_directories(dir_.parent_path());
-    generate_tag_capture(dir_, options);
+    sim::SimScene scene = sim::load_sim_scene(fs::path(ARPIPE_SOURCE_DIR) / "configs" / "sim" / "default.toml");
+    scene.camera.pixel_format = format;
+    // The same lens at another resolution: focal lengths scale, and so does the principal point
+    // measured from the image's corner (-0.5, -0.5).
+    const CameraModel& full = scene.camera.model;
+    const double scale = double(width) / full.width();
+    std::vector<double> intrinsics = full.intrinsics();
+    intrinsics[0] *= scale;
+    intrinsics[1] *= scale;
+    intrinsics[2] = (intrinsics[2] + 0.5) * scale - 0.5;
+    intrinsics[3] = (intrinsics[3] + 0.5) * scale - 0.5;
+    scene.camera.model = CameraModel(full.lensmodel(), intrinsics, width, height);
+    sim::SimulateOptions options;
+    options.out_dir = dir_;
+    options.frames = 1;
+    sim::simulate(scene, options);
   }
   ~ScratchCapture() { fs::remove_all(dir_); }
   const fs::path& dir() const { return dir_; }
@@ -160,16 +182,6 @@ class ScratchCapture {
  private:
   fs::path dir_;
 };
-
-TagCaptureOptions first_frame_only(PixelFormat format, int width = 640, int height = 480) {
-  TagCaptureOptions options;
-  options.frames = 1;
-  options.look_away_frames = 0;
-  options.pixel_format = format;
-  options.width = width;
-  options.height = height;
-  return options;
-}
 
 // Whether the whole tag (its four corners) is in the image at the true pose: the independent
 // statement of "the tag is in view" that decides whether the frame must track.
@@ -199,22 +211,18 @@ bool tag_entirely_out_of_view(const CameraModel& camera, const SE3& T_cam_world,
   return true;
 }
 
-// A generated capture (the first 0.8 s of the generator's orbit, 0.39-0.57 m over a 10 cm tag36h11;
-// 640x480, OPENCV4 lens, YUYV, sensor noise; its last 3 frames look away) through the stage.
-TEST(GeneratedCapture, PoseMatchesGroundTruthAndTheAnchorLandsWithinOnePixel) {
-  TagCaptureOptions options;
-  options.frames = 24;
-  options.look_away_frames = 3;
-  const ScratchCapture capture("orbit", options);
-  const RecordingReader reader(capture.dir());
+// The embedded default capture through the stage.
+TEST(SimulatedCapture, PoseMatchesGroundTruthAndTheAnchorLandsWithinOnePixel) {
+  ASSERT_TRUE(fs::exists(kDefaultCapture / "recording.json")) << "the build simulates " << kDefaultCapture;
+  const RecordingReader reader(kDefaultCapture);
   const auto camera = std::make_shared<CameraModel>(reader.camera_model());
   const auto& truth = reader.ground_truth();
   ASSERT_EQ(truth.size(), reader.frame_count());
 
-  Config config;  // the default bundle: tag 0 of tag36h11, 10 cm, at the origin, as generated
+  Config config;  // the default bundle: tag 0 of tag36h11, 10 cm, at the origin, as simulated
   TagTracker tracker;
   tracker.configure(config);
-  int tracked = 0, lost = 0;
+  int tracked = 0, sharp = 0, lost = 0;
   for (size_t i = 0; i < reader.frame_count(); ++i) {
     FrameContext ctx;
     reader.read(i, ctx.camera);
@@ -226,23 +234,35 @@ TEST(GeneratedCapture, PoseMatchesGroundTruthAndTheAnchorLandsWithinOnePixel) {
       ASSERT_EQ(ctx.pose.state, TrackState::Tracking) << "frame " << i;
       ++tracked;
       EXPECT_EQ(ctx.pose.tags_used, 1);
-      // Corners: the renders are exact up to 4x4 area sampling and sensor noise of 1/255, so the
-      // refined corners land within a few hundredths of a pixel of the projected truth (0.19 px worst
-      // seen, where noise meets a short edge); libapriltag's own sit 0.15-0.4 px inside.
       ASSERT_EQ(ctx.pose.tags.size(), 1u);
       const auto world_corners = bundle_tag_world_corners(config.track.bundle[0]);
-      for (size_t c = 0; c < 4; ++c) {
-        const Vec2 expected_corner = *camera->project(T_true * world_corners[c]);
-        const Vec2& corner = ctx.pose.tags[0].corners[c];
-        EXPECT_LT(norm(Vec2{corner[0] - expected_corner[0], corner[1] - expected_corner[1]}), 0.3)
-            << "frame " << i << " corner " << c;
+      // How far the tag's corners move in the image while the shutter is open: the tight bounds
+      // below assume sharp corners (the blurred frames of the capture's fast turn away, up to ~3 px,
+      // keep only the anchor criterion; pose under motion blur is the motion issue's subject).
+      double blur_px = 0;
+      for (const Vec3& corner : world_corners) {
+        const Vec2 at_start = *camera->project(truth[i].T_cam_world_start * corner);
+        const Vec2 at_end = *camera->project(truth[i].T_cam_world_end * corner);
+        blur_px = std::max(blur_px, norm(Vec2{at_end[0] - at_start[0], at_end[1] - at_start[1]}));
       }
-      // The tag is 90-140 px across at 0.39-0.57 m. With ~0.05 px corner noise the depth sigma is
-      // about d^2 sigma / (f s) = 0.25 mm and the tilt sigma about 0.1 degree (tag_pose_solver_test
-      // derives these scales): bounds of about four sigma.
-      EXPECT_LT(norm(ctx.pose.T_cam_world.translation() - T_true.translation()), 1e-3) << "frame " << i;
-      EXPECT_LT(rotation_angle_between(ctx.pose.T_cam_world, T_true), 0.5 * kDeg) << "frame " << i;
-      EXPECT_LT(ctx.pose.reprojection_rms_px, 0.2) << "frame " << i;
+      if (blur_px < 1.0) {
+        ++sharp;
+        // Corners: the renders are exact up to area sampling and sensor noise, so the refined
+        // corners land within a few hundredths of a pixel of the projected truth (0.3 px allows
+        // noise on a short edge); libapriltag's own sit 0.15-0.4 px inside.
+        for (size_t c = 0; c < 4; ++c) {
+          const Vec2 expected_corner = *camera->project(T_true * world_corners[c]);
+          const Vec2& corner = ctx.pose.tags[0].corners[c];
+          EXPECT_LT(norm(Vec2{corner[0] - expected_corner[0], corner[1] - expected_corner[1]}), 0.3)
+              << "frame " << i << " corner " << c;
+        }
+        // The tag is 90-140 px across at 0.45-0.55 m. With ~0.05 px corner noise the depth sigma
+        // is about d^2 sigma / (f s) = 0.25 mm and the tilt sigma about 0.1 degree
+        // (tag_pose_solver_test derives these scales): bounds of about four sigma.
+        EXPECT_LT(norm(ctx.pose.T_cam_world.translation() - T_true.translation()), 1e-3) << "frame " << i;
+        EXPECT_LT(rotation_angle_between(ctx.pose.T_cam_world, T_true), 0.5 * kDeg) << "frame " << i;
+        EXPECT_LT(ctx.pose.reprojection_rms_px, 0.2) << "frame " << i;
+      }
       // The acceptance criterion: the world origin (the virtual object's anchor) projects
       // within 1 px of where the true pose puts it.
       const auto estimated = camera->project(ctx.pose.T_cam_world * Vec3{0, 0, 0});
@@ -255,16 +275,16 @@ TEST(GeneratedCapture, PoseMatchesGroundTruthAndTheAnchorLandsWithinOnePixel) {
     }
   }
   // The capture holds both kinds of frame, or this test would prove little.
-  EXPECT_GE(tracked, 20);
+  EXPECT_GE(tracked, 40);
+  EXPECT_GE(sharp, 20);
   EXPECT_GE(lost, 3);
 }
 
 // GREY frames are detected in place (with their stride) and NV12 luma is limited range: both paths
 // must give the pose of the first frame, and a padded stride must not change a thing.
-TEST(GeneratedCapture, GreyWithAnyStrideAndNv12TrackLikeTheTruth) {
+TEST(SimulatedCapture, GreyWithAnyStrideAndNv12TrackLikeTheTruth) {
   for (const PixelFormat format : {PixelFormat::GREY, PixelFormat::NV12}) {
-    const ScratchCapture capture(std::string("format-") + std::string(pixel_format_name(format)),
-                                 first_frame_only(format, 320, 240));
+    const ScratchCapture capture(std::string("format-") + std::string(pixel_format_name(format)), format, 320, 240);
     const RecordingReader reader(capture.dir());
     const auto camera = std::make_shared<CameraModel>(reader.camera_model());
     const SE3& T_true = reader.ground_truth().at(0).T_cam_world_mid;
@@ -300,8 +320,8 @@ TEST(GeneratedCapture, GreyWithAnyStrideAndNv12TrackLikeTheTruth) {
   }
 }
 
-TEST(GeneratedCapture, TagsOutsideTheBundleAreListedButNotUsed) {
-  const ScratchCapture capture("other-id", first_frame_only(PixelFormat::YUYV, 320, 240));
+TEST(SimulatedCapture, TagsOutsideTheBundleAreListedButNotUsed) {
+  const ScratchCapture capture("other-id", PixelFormat::YUYV, 320, 240);
   const RecordingReader reader(capture.dir());
   const auto camera = std::make_shared<CameraModel>(reader.camera_model());
   Config config;
@@ -317,8 +337,8 @@ TEST(GeneratedCapture, TagsOutsideTheBundleAreListedButNotUsed) {
   EXPECT_EQ(ctx.pose.tags[0].id, 0);
 }
 
-TEST(GeneratedCapture, ARefusedReconfigureKeepsTheRunningConfig) {
-  const ScratchCapture capture("reconfigure", first_frame_only(PixelFormat::YUYV, 320, 240));
+TEST(SimulatedCapture, ARefusedReconfigureKeepsTheRunningConfig) {
+  const ScratchCapture capture("reconfigure", PixelFormat::YUYV, 320, 240);
   const RecordingReader reader(capture.dir());
   const auto camera = std::make_shared<CameraModel>(reader.camera_model());
   TagTracker tracker;
