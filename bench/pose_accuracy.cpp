@@ -21,6 +21,7 @@ namespace {
 struct Errors {
   std::vector<double> position_mm, rotation_deg, anchor_px, ms;
   int tracked = 0, frames = 0;
+  size_t worst_frame = 0;  // of the centre error
 };
 
 double median(std::vector<double> v) {
@@ -56,6 +57,7 @@ Errors measure(const RecordingReader& reader, const std::vector<Frame>& frames, 
       const SE3& estimate = ctx.pose.T_cam_world;
       // Camera centre in the world frame, and the relative rotation.
       const Vec3 centre_error = estimate.inverse().translation() - truth.inverse().translation();
+      if (e.position_mm.empty() || norm(centre_error) * 1e3 > maximum(e.position_mm)) e.worst_frame = i;
       e.position_mm.push_back(norm(centre_error) * 1e3);
       e.rotation_deg.push_back(rotation_angle_between(estimate, truth) * 180 / M_PI);
       const auto a = model->project(estimate * Vec3{0, 0, 0});
@@ -84,15 +86,15 @@ int main(int argc, char** argv) {
                reader.info().height, pixel_format_name(reader.info().pixel_format));
     fmt::print(
         "| quad_decimate | refine_corners | tracked | ms/frame (median) | centre error mm (median / max) | "
-        "rotation error deg (median / max) | anchor error px (median / max) |\n"
-        "|---:|---|---:|---:|---:|---:|---:|\n");
+        "rotation error deg (median / max) | anchor error px (median / max) | worst frame |\n"
+        "|---:|---|---:|---:|---:|---:|---:|---:|\n");
     for (double decimate : {1.0, 2.0, 4.0})
       for (bool refine : {false, true}) {
         const Errors e = measure(reader, frames, decimate, refine);
-        fmt::print("| {} | {} | {}/{} | {:.2f} | {:.2f} / {:.2f} | {:.3f} / {:.3f} | {:.3f} / {:.3f} |\n", decimate,
+        fmt::print("| {} | {} | {}/{} | {:.2f} | {:.2f} / {:.2f} | {:.3f} / {:.3f} | {:.3f} / {:.3f} | {} |\n", decimate,
                    refine ? "yes" : "no", e.tracked, e.frames, median(e.ms), median(e.position_mm),
                    maximum(e.position_mm), median(e.rotation_deg), maximum(e.rotation_deg), median(e.anchor_px),
-                   maximum(e.anchor_px));
+                   maximum(e.anchor_px), e.worst_frame);
       }
     return 0;
   } catch (const std::exception& ex) {
