@@ -19,6 +19,7 @@
 #include <set>
 #include <sstream>
 
+#include "core/config/toml_type_phrase.h"
 #include "core/scene/asset_error.h"
 #include "core/scene/gltf_loader.h"
 #include "core/track/tag_family.h"
@@ -43,21 +44,8 @@ std::string join(const std::vector<std::string_view>& items, std::string_view se
 
 std::string in_quotes(std::string_view text) { return fmt::format("\"{}\"", text); }
 
-std::string type_phrase(const toml::node& node) {
-  switch (node.type()) {
-    case toml::node_type::string: return "a string";
-    case toml::node_type::integer: return "an integer";
-    case toml::node_type::floating_point: return "a float";
-    case toml::node_type::boolean: return "a boolean";
-    case toml::node_type::date: return "a date";
-    case toml::node_type::time: return "a time";
-    case toml::node_type::date_time: return "a date-time";
-    case toml::node_type::array: return "an array";
-    case toml::node_type::table: return "a table";
-    case toml::node_type::none: break;
-  }
-  return "nothing";
-}
+std::string type_phrase(const toml::node& node) { return std::string(toml_type_phrase(node)); }
+
 
 std::string show(const Vec3& v) { return fmt::format("[{}, {}, {}]", v[0], v[1], v[2]); }
 

@@ -20,6 +20,7 @@
 #include <set>
 #include <sstream>
 
+#include "core/config/toml_type_phrase.h"
 #include "core/track/tag_family.h"
 
 namespace arpipe {
@@ -35,21 +36,6 @@ std::string join(const std::vector<std::string>& items) {
   return out;
 }
 
-std::string_view type_phrase(const toml::node& node) {
-  switch (node.type()) {
-    case toml::node_type::string: return "a string";
-    case toml::node_type::integer: return "an integer";
-    case toml::node_type::floating_point: return "a float";
-    case toml::node_type::boolean: return "a boolean";
-    case toml::node_type::date: return "a date";
-    case toml::node_type::time: return "a time";
-    case toml::node_type::date_time: return "a date-time";
-    case toml::node_type::array: return "an array";
-    case toml::node_type::table: return "a table";
-    case toml::node_type::none: break;
-  }
-  return "nothing";
-}
 
 // "file:line:column" for file nodes; overrides have no useful line, so they name themselves.
 std::string place_of(const toml::source_region& region, const std::string& fallback) {
@@ -109,7 +95,7 @@ class ConfigReader {
   const toml::table* table(const toml::table& parent, const std::string& prefix, const char* key) const {
     const toml::node* node = parent.get(key);
     if (node == nullptr) return nullptr;
-    if (!node->is_table()) fail_got(*node, prefix + key, "a table", std::string(type_phrase(*node)));
+    if (!node->is_table()) fail_got(*node, prefix + key, "a table", std::string(toml_type_phrase(*node)));
     return node->as_table();
   }
 
@@ -117,18 +103,18 @@ class ConfigReader {
   const toml::array* array_of_tables(const toml::table& parent, const std::string& prefix, const char* key) const {
     const toml::node* node = parent.get(key);
     if (node == nullptr) return nullptr;
-    if (!node->is_array()) fail_got(*node, prefix + key, "an array of tables", std::string(type_phrase(*node)));
+    if (!node->is_array()) fail_got(*node, prefix + key, "an array of tables", std::string(toml_type_phrase(*node)));
     const toml::array& array = *node->as_array();
     for (size_t i = 0; i < array.size(); ++i)
       if (!array[i].is_table())
-        fail_got(array[i], fmt::format("{}{}[{}]", prefix, key, i), "a table", std::string(type_phrase(array[i])));
+        fail_got(array[i], fmt::format("{}{}[{}]", prefix, key, i), "a table", std::string(toml_type_phrase(array[i])));
     return &array;
   }
 
   void read(const toml::table& t, const std::string& prefix, const char* key, bool& out) const {
     const toml::node* node = t.get(key);
     if (node == nullptr) return;
-    if (!node->is_boolean()) fail_got(*node, prefix + key, "a boolean (true or false)", std::string(type_phrase(*node)));
+    if (!node->is_boolean()) fail_got(*node, prefix + key, "a boolean (true or false)", std::string(toml_type_phrase(*node)));
     out = node->as_boolean()->get();
   }
 
@@ -136,7 +122,7 @@ class ConfigReader {
             int64_t min = std::numeric_limits<int64_t>::min(), int64_t max = std::numeric_limits<int64_t>::max()) const {
     const toml::node* node = t.get(key);
     if (node == nullptr) return;
-    if (!node->is_integer()) fail_got(*node, prefix + key, "an integer", std::string(type_phrase(*node)));
+    if (!node->is_integer()) fail_got(*node, prefix + key, "an integer", std::string(toml_type_phrase(*node)));
     const int64_t value = node->as_integer()->get();
     if (value < min || value > max) fail_got(*node, prefix + key, range_phrase("an integer", min, max), fmt::format("{}", value));
     out = value;
@@ -166,7 +152,7 @@ class ConfigReader {
     const toml::node* node = t.get(key);
     if (node == nullptr) return;
     const std::string expected = choices.empty() ? "a string" : "one of " + join(quoted(choices));
-    if (!node->is_string()) fail_got(*node, prefix + key, expected, std::string(type_phrase(*node)));
+    if (!node->is_string()) fail_got(*node, prefix + key, expected, std::string(toml_type_phrase(*node)));
     const std::string& value = node->as_string()->get();
     if (!choices.empty() && std::find(choices.begin(), choices.end(), value) == choices.end())
       fail_got(*node, prefix + key, expected, toml_string(value));
@@ -184,7 +170,7 @@ class ConfigReader {
     const toml::node* node = t.get(key);
     if (node == nullptr) return;
     const std::string expected = "an array of 3 " + item_expected + " [x, y, z]";
-    if (!node->is_array()) fail_got(*node, prefix + key, expected, std::string(type_phrase(*node)));
+    if (!node->is_array()) fail_got(*node, prefix + key, expected, std::string(toml_type_phrase(*node)));
     const toml::array& array = *node->as_array();
     if (array.size() != 3) fail_got(*node, prefix + key, expected, fmt::format("{} items", array.size()));
     Vec3 value{};
@@ -232,7 +218,7 @@ class ConfigReader {
     else if (node.is_floating_point())
       value = node.as_floating_point()->get();
     else
-      fail_got(node, key, expected, std::string(type_phrase(node)));
+      fail_got(node, key, expected, std::string(toml_type_phrase(node)));
     if (!std::isfinite(value)) fail_got(node, key, "a finite number", format_toml_float(value));
     return value;
   }
@@ -450,7 +436,7 @@ void merge_override(toml::table& target, toml::table& source, const std::string&
         merge_override_into_array(*existing->as_array(), *value.as_table(), dotted, label);
         continue;
       }
-      override_error(label, fmt::format("'{}' is {}, not a table", dotted, type_phrase(*existing)));
+      override_error(label, fmt::format("'{}' is {}, not a table", dotted, toml_type_phrase(*existing)));
     }
     if (existing == nullptr)
       if (const auto indexed = first_indexed_path(value, dotted))

@@ -19,6 +19,7 @@
 #include "core/scene/asset_error.h"
 #include "core/track/tag_family.h"
 #include "tests/scene/gltf_test_files.h"
+#include "tests/sim/sim_test_support.h"
 
 // apriltag.h after the project headers: its family struct is what tag_family.h forward-declares.
 #include <apriltag/apriltag.h>
@@ -315,28 +316,12 @@ TEST(SceneShader, MirrorSphereNormalIsExact) {
   }
 }
 
-// An 8 x 4 HDR sky with a distinct colour per pixel; returns the pixels as the file holds them.
-std::vector<Rgb> write_sky(const fs::path& path) {
-  cv::Mat sky(4, 8, CV_32FC3);
-  for (int row = 0; row < 4; ++row)
-    for (int col = 0; col < 8; ++col)
-      sky.at<cv::Vec3f>(row, col) = {float(0.25 + col), float(1 + 2 * row), float(0.5 + row * col)};
-  EXPECT_TRUE(cv::imwrite(path.string(), sky));
-  const cv::Mat back = cv::imread(path.string(), cv::IMREAD_ANYDEPTH | cv::IMREAD_COLOR);
-  std::vector<Rgb> pixels;
-  for (int row = 0; row < 4; ++row)
-    for (int col = 0; col < 8; ++col) {
-      const cv::Vec3f bgr = back.at<cv::Vec3f>(row, col);
-      pixels.push_back({bgr[2], bgr[1], bgr[0]});
-    }
-  return pixels;
-}
 
 TEST(SceneShader, MirrorSphereReflectsTheSkyAlongTheMirrorDirection) {
   // Each of the sky's 32 pixel centres, seen in a mirror sphere along r = d - 2 (d.n) n from
   // several random normals, shows that pixel times the mirror's reflectance.
   const fs::path path = temp_dir("mirror") / "sky.hdr";
-  const std::vector<Rgb> pixels = write_sky(path);
+  const std::vector<Rgb> pixels = test::write_test_sky(path);
   SimScene scene;
   scene.environment.hdr_path = path;
   scene.environment.radiance = {1, 1, 1};

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <fmt/format.h>
+#include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -10,6 +11,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
+#include <vector>
 
 #include "capture/sim/sim_scene.h"
 
@@ -60,6 +62,24 @@ inline SimLight overhead_sun(double irradiance) {
   light.direction_to_light = {0, 0, 1};
   light.irradiance = irradiance;
   return light;
+}
+
+// An 8 x 4 HDR sky with a distinct colour per pixel; returns the pixels as the file holds them
+// (RGBE rounds them), RGB, row-major.
+inline std::vector<Rgb> write_test_sky(const fs::path& path) {
+  cv::Mat sky(4, 8, CV_32FC3);
+  for (int row = 0; row < 4; ++row)
+    for (int col = 0; col < 8; ++col)
+      sky.at<cv::Vec3f>(row, col) = {float(0.25 + col), float(1 + 2 * row), float(0.5 + row * col)};
+  EXPECT_TRUE(cv::imwrite(path.string(), sky));
+  const cv::Mat back = cv::imread(path.string(), cv::IMREAD_ANYDEPTH | cv::IMREAD_COLOR);
+  std::vector<Rgb> pixels;
+  for (int row = 0; row < 4; ++row)
+    for (int col = 0; col < 8; ++col) {
+      const cv::Vec3f bgr = back.at<cv::Vec3f>(row, col);
+      pixels.push_back({bgr[2], bgr[1], bgr[0]});
+    }
+  return pixels;
 }
 
 // Reads a float RGB PFM written by the simulator (linear image), as OpenCV BGR.

@@ -15,6 +15,7 @@
 
 #include "core/scene/asset_error.h"
 #include "core/track/tag_family.h"
+#include "tests/sim/sim_test_support.h"
 
 namespace arpipe::sim {
 namespace {
@@ -213,23 +214,6 @@ TEST(SimTexture, EquirectangularMappingFollowsSimScene) {
   EXPECT_LT(u, 1.0);
 }
 
-// An 8 x 4 HDR sky with a distinct colour per pixel; returns the pixels as the file holds them
-// (RGBE rounds them), RGB, row-major.
-std::vector<Rgb> write_sky(const fs::path& path) {
-  cv::Mat sky(4, 8, CV_32FC3);
-  for (int row = 0; row < 4; ++row)
-    for (int col = 0; col < 8; ++col)
-      sky.at<cv::Vec3f>(row, col) = {float(0.25 + col), float(1 + 2 * row), float(0.5 + row * col)};
-  EXPECT_TRUE(cv::imwrite(path.string(), sky));
-  const cv::Mat back = cv::imread(path.string(), cv::IMREAD_ANYDEPTH | cv::IMREAD_COLOR);
-  std::vector<Rgb> pixels;
-  for (int row = 0; row < 4; ++row)
-    for (int col = 0; col < 8; ++col) {
-      const cv::Vec3f bgr = back.at<cv::Vec3f>(row, col);
-      pixels.push_back({bgr[2], bgr[1], bgr[0]});
-    }
-  return pixels;
-}
 
 Vec3 direction_at(double u, double v, double rotation = 0) {
   const double phi = 2 * kPi * u - rotation, theta = kPi * v;
@@ -238,7 +222,7 @@ Vec3 direction_at(double u, double v, double rotation = 0) {
 
 TEST(SimTexture, HdrSkyIsBilinearAndWrapsInU) {
   const fs::path path = temp_dir("sky") / "sky.hdr";
-  const std::vector<Rgb> pixels = write_sky(path);
+  const std::vector<Rgb> pixels = test::write_test_sky(path);
   SimEnvironment env;
   env.hdr_path = path;
   env.radiance = {2, 1, 0.5};
