@@ -1,13 +1,20 @@
 // CameraRayGrid: unprojection grid and its self-check.
 #include "capture/sim/camera_ray_grid.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 namespace arpipe::sim {
 
 CameraRayGrid::CameraRayGrid(const CameraModel& model, double max_error_px) {
+  // A lens mrcal cannot unproject (CAHVORE) would otherwise render black frames without a word.
+  if (!model.unproject(Vec2{(model.width() - 1) / 2.0, (model.height() - 1) / 2.0}))
+    throw std::invalid_argument(fmt::format("the simulator cannot cast rays through a {} lens: mrcal cannot unproject it",
+                                            model.lensmodel()));
   // Pixel spacing is plenty for ordinary lenses; strong fisheyes need finer grids near the edge.
   for (double spacing = 1.0;; spacing /= 2) {
     build(model, spacing);

@@ -13,7 +13,8 @@ class CameraRayGrid {
  public:
   // Unprojects a grid over the whole image (pixel centres at integer coordinates, so the image
   // spans [-0.5, width - 0.5]) with the spacing halved until interpolation agrees with a direct
-  // unprojection to within max_error_px (checked on cell midpoints, reprojected).
+  // unprojection to within max_error_px (checked on cell midpoints, reprojected). Throws
+  // std::invalid_argument for a lens mrcal cannot unproject.
   explicit CameraRayGrid(const CameraModel& model, double max_error_px = 0.002);
 
   // Unit camera-frame direction (x right, y down, z forward) through pixel position (x, y);

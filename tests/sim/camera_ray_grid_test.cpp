@@ -6,6 +6,8 @@
 
 #include <cmath>
 #include <random>
+#include <stdexcept>
+#include <string>
 
 namespace arpipe::sim {
 namespace {
@@ -48,6 +50,17 @@ TEST(CameraRayGrid, DistortedLensWithinTheRequestedError) {
   // The random positions include cell midpoints' worst cases only statistically: allow 2x the
   // midpoint check, still 50x below the simulator's 0.1 px corner budget.
   EXPECT_LT(worst_reprojection_px(model, grid), 0.004);
+}
+
+TEST(CameraRayGrid, ALensMrcalCannotUnprojectIsRefusedByName) {
+  const CameraModel cahvore("LENSMODEL_CAHVORE_linearity=0.00",
+                            {300, 300, 160, 120, 0.01, -0.02, 0.1, 0.01, 0.001, 0.0, 0.0, 0.0}, 320, 240);
+  try {
+    const CameraRayGrid grid(cahvore);
+    FAIL() << "expected std::invalid_argument";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("CAHVORE"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
