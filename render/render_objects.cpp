@@ -13,17 +13,13 @@
 namespace arpipe {
 namespace {
 
-constexpr std::string_view kBuiltinPrefix = "builtin:";
-
 Mesh load_mesh(const Config& config, size_t object_index, const std::string& source) {
-  if (source.rfind(kBuiltinPrefix, 0) == 0) {
-    const std::string name = source.substr(kBuiltinPrefix.size());
-    if (name == "cube") return make_cube_mesh();
-    if (name == "pyramid") return make_pyramid_mesh();
+  if (is_builtin_mesh_source(source)) {
+    if (auto mesh = make_builtin_mesh(source)) return std::move(*mesh);
     throw ConfigError(fmt::format("{}: render.objects[{}].mesh: unknown builtin mesh \"{}\" (expected "
-                                  "\"builtin:cube\", \"builtin:pyramid\" or a glTF 2.0 file)",
+                                  "{} or a glTF 2.0 file)",
                                   config.file.empty() ? std::string("config") : config.file.string(), object_index,
-                                  source));
+                                  source, kBuiltinMeshNames));
   }
   return load_gltf_mesh(source);  // relative to the working directory, like every path in a config
 }
@@ -60,7 +56,7 @@ std::vector<RenderObject> load_render_objects(const Config& config) {
     out.scale = object.scale;
     out.bounds = scaled(found->second.bounds, object.scale);
     out.T_world_object = SE3::from_rt({0, 0, object.yaw_rad}, object.position_m);
-    if (object.mesh.rfind(kBuiltinPrefix, 0) == 0)
+    if (is_builtin_mesh_source(object.mesh))
       out.base_color = std::array<float, 4>{static_cast<float>(object.color[0]), static_cast<float>(object.color[1]),
                                             static_cast<float>(object.color[2]), 1.0f};
     objects.push_back(std::move(out));

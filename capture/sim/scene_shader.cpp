@@ -18,6 +18,7 @@
 #include "capture/sim/light_sampling.h"
 #include "capture/sim/sim_textures.h"
 #include "core/scene/asset_error.h"
+#include "core/scene/builtin_meshes.h"
 #include "core/scene/gltf_loader.h"
 
 namespace arpipe::sim {
@@ -144,7 +145,14 @@ struct SceneShader::Impl {
                      fmt::format("mesh_scale must be positive, got {}", object.mesh_scale));
         Mesh mesh;
         try {
-          mesh = load_gltf_mesh(object.mesh_path);
+          if (!object.mesh_builtin.empty()) {
+            auto builtin = make_builtin_mesh(object.mesh_builtin);
+            if (!builtin) throw AssetError(fmt::format("unknown builtin mesh \"{}\" (expected {})", object.mesh_builtin,
+                                                       kBuiltinMeshNames));
+            mesh = std::move(*builtin);
+          } else {
+            mesh = load_gltf_mesh(object.mesh_path);
+          }
         } catch (const AssetError& e) {
           throw AssetError(fmt::format("object \"{}\": {}", object.name, e.what()));
         }

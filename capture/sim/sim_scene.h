@@ -55,7 +55,8 @@ struct SimObject {
   double width_m = 0;          // Plane: extent along local x, centred on the origin
   double height_m = 0;         // Plane: extent along local y
   double radius_m = 0;         // Sphere: centred on the local origin
-  std::filesystem::path mesh_path;  // Mesh: glTF 2.0, loaded with core/scene/gltf_loader.h
+  std::filesystem::path mesh_path;  // Mesh: glTF 2.0, loaded with core/scene/gltf_loader.h, or
+  std::string mesh_builtin;         //   a builtin mesh ("builtin:cube": core/scene/builtin_meshes.h)
   double mesh_scale = 1.0;          // Mesh: uniform scale applied in the object frame
   SimMaterial material;
   bool is_virtual = false;  // left out of the camera frames, drawn only in the ground-truth composite

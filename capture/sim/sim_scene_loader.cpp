@@ -21,6 +21,7 @@
 
 #include "core/config/toml_type_phrase.h"
 #include "core/scene/asset_error.h"
+#include "core/scene/builtin_meshes.h"
 #include "core/scene/gltf_loader.h"
 #include "core/track/tag_family.h"
 
@@ -604,12 +605,19 @@ SimObject read_object(const Section& s, size_t index) {
     only({"width_m", "height_m", "texture"}, "plane");
     only({"radius_m"}, "sphere");
     out.shape = SimObject::Shape::Mesh;
-    out.mesh_path = s.file("mesh", "a glTF 2.0 file (.gltf or .glb)");
-    try {
-      load_gltf_mesh(out.mesh_path);  // the simulator loads it again; this makes a bad file a scene error
-    } catch (const AssetError& e) {
-      s.fail("mesh", fmt::format("expected a valid glTF 2.0 file, found one that is not ({}): {}",
-                                 out.mesh_path.string(), e.what()));
+    const std::string source = s.string("mesh", "");
+    if (is_builtin_mesh_source(source)) {
+      if (!make_builtin_mesh(source))
+        s.fail("mesh", fmt::format("one of {} or a glTF 2.0 file", kBuiltinMeshNames), in_quotes(source));
+      out.mesh_builtin = source;
+    } else {
+      out.mesh_path = s.file("mesh", fmt::format("a glTF 2.0 file (.gltf or .glb) or one of {}", kBuiltinMeshNames));
+      try {
+        load_gltf_mesh(out.mesh_path);  // the simulator loads it again; this makes a bad file a scene error
+      } catch (const AssetError& e) {
+        s.fail("mesh", fmt::format("expected a valid glTF 2.0 file, found one that is not ({}): {}",
+                                   out.mesh_path.string(), e.what()));
+      }
     }
     out.mesh_scale = s.number("mesh_scale", out.mesh_scale, kPositive);
   }

@@ -82,4 +82,12 @@ Mesh make_pyramid_mesh(double base_m, double height_m, int subdivisions) {
   return builder.finish();
 }
 
+bool is_builtin_mesh_source(std::string_view source) { return source.substr(0, kBuiltinMeshPrefix.size()) == kBuiltinMeshPrefix; }
+
+std::optional<Mesh> make_builtin_mesh(std::string_view source) {
+  if (source == "builtin:cube") return make_cube_mesh();
+  if (source == "builtin:pyramid") return make_pyramid_mesh();
+  return std::nullopt;
+}
+
 }  // namespace arpipe

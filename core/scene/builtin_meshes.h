@@ -2,6 +2,9 @@
 // base on z = 0, centred on the object origin in x and y, about 6 cm across.
 #pragma once
 
+#include <optional>
+#include <string_view>
+
 #include "core/scene/mesh.h"
 
 namespace arpipe {
@@ -10,5 +13,12 @@ namespace arpipe {
 // per vertex: between vertices the rasteriser draws straight lines, so long edges need vertices.
 Mesh make_cube_mesh(double edge_m = 0.06, int subdivisions = 8);
 Mesh make_pyramid_mesh(double base_m = 0.06, double height_m = 0.06, int subdivisions = 8);
+
+// How a scene names a builtin mesh instead of a file: "builtin:cube", "builtin:pyramid".
+inline constexpr std::string_view kBuiltinMeshPrefix = "builtin:";
+inline constexpr std::string_view kBuiltinMeshNames = "\"builtin:cube\", \"builtin:pyramid\"";
+bool is_builtin_mesh_source(std::string_view source);
+// The builtin mesh a source names, at its default size; nullopt for an unknown builtin name.
+std::optional<Mesh> make_builtin_mesh(std::string_view source);
 
 }  // namespace arpipe

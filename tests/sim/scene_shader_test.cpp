@@ -609,5 +609,30 @@ TEST(SceneShader, SameSeedsGiveBitIdenticalRadiance) {
   EXPECT_TRUE(any_difference);
 }
 
+// A builtin cube (6 cm, base on z = 0, centred) on the floor: rays straight down hit its top
+// inside |x| < 3 cm and the floor outside, both lit exactly by the overhead light.
+TEST(SceneShader, BuiltinCubeStandsOnItsBase) {
+  SimScene scene;
+  scene.objects.push_back(floor_plane({0.5, 0.5, 0.5}));
+  SimObject cube;
+  cube.name = "cube";
+  cube.shape = SimObject::Shape::Mesh;
+  cube.mesh_builtin = "builtin:cube";
+  cube.material.albedo = {0.8, 0.3, 0.1};
+  scene.objects.push_back(cube);
+  scene.lights.push_back(directional({0, 0, 1}, 2.0));
+  const SceneShader shader(scene, false);
+  const Vec3 down{0, 0, -1};
+  expect_rgb_near(once(shader, {0.025, 0.01, 1}, down), {0.8 * 2 / kPi, 0.3 * 2 / kPi, 0.1 * 2 / kPi}, 1e-6, "top");
+  expect_rgb_near(once(shader, {0.035, 0.01, 1}, down), {0.5 * 2 / kPi, 0.5 * 2 / kPi, 0.5 * 2 / kPi}, 1e-6, "floor");
+  // Its +x side seen horizontally, lit at 45 degrees: just below the 6 cm top the face is there,
+  // just above it the ray misses everything (no sky: black).
+  scene.lights = {directional(normalized(Vec3{1, 0, 1}), 2.0)};
+  const SceneShader side_lit(scene, false);
+  const double side = 0.8 * 2 * std::cos(kPi / 4) / kPi;
+  expect_rgb_near(once(side_lit, {1, 0, 0.059}, {-1, 0, 0}), {side, side * 0.3 / 0.8, side * 0.1 / 0.8}, 1e-6, "side");
+  EXPECT_EQ(once(side_lit, {1, 0, 0.061}, {-1, 0, 0}), (Rgb{0, 0, 0}));
+}
+
 }  // namespace
 }  // namespace arpipe::sim

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "capture/sim/sim_scene_loader.h"
+#include "core/config/config.h"
 
 namespace arpipe::sim {
 namespace {
@@ -309,7 +310,19 @@ TEST(SimSceneLoaderExamples, DefaultIsTheCheapEmbeddedCapture) {
   EXPECT_EQ(scene.lights[0].kind, SimLight::Kind::Directional);
   EXPECT_TRUE(scene.environment.hdr_path.empty());
   EXPECT_GT(scene.environment.radiance[0], 0);
-  EXPECT_FALSE(scene.has_virtual_objects());
+  // Its one virtual object is the one configs/arpipe.toml draws, so that the ground-truth
+  // composite is what arpiped's composite should be.
+  const Config config = load_config(fs::path(ARPIPE_SOURCE_DIR) / "configs" / "arpipe.toml");
+  ASSERT_EQ(config.render.objects.size(), 1u);
+  const SceneObject& drawn = config.render.objects[0];
+  const auto is_virtual = [](const SimObject& o) { return o.is_virtual; };
+  ASSERT_EQ(std::count_if(scene.objects.begin(), scene.objects.end(), is_virtual), 1);
+  const SimObject& cube = *std::find_if(scene.objects.begin(), scene.objects.end(), is_virtual);
+  EXPECT_EQ(cube.mesh_builtin, drawn.mesh);
+  EXPECT_EQ(cube.T_world_object.translation(), drawn.position_m);
+  EXPECT_EQ(cube.T_world_object.rotation_vector()[2], drawn.yaw_rad);
+  EXPECT_EQ(cube.mesh_scale, drawn.scale);
+  EXPECT_EQ(cube.material.albedo, (Rgb{drawn.color[0], drawn.color[1], drawn.color[2]}));
   // The tag is in full view at the start and out of view at the last keyframe (t = 2 s, after
   // the last frame's exposure start at 59/30 s).
   const auto& keys = scene.trajectory.keyframes;
@@ -668,6 +681,15 @@ TEST(SimSceneLoaderErrors, LoadNamesTheFileItCannotRead) {
   } catch (const SceneError& e) {
     EXPECT_EQ(std::string(e.what()).rfind(file.string() + ":3:", 0), 0u) << e.what();
   }
+}
+
+TEST(SimSceneLoader, BuiltinMeshesNeedNoFile) {
+  const SimScene scene = parse("[[object]]\nshape = \"mesh\"\nmesh = \"builtin:cube\"\n");
+  ASSERT_EQ(scene.objects.size(), 1u);
+  EXPECT_EQ(scene.objects[0].shape, SimObject::Shape::Mesh);
+  EXPECT_EQ(scene.objects[0].mesh_builtin, "builtin:cube");
+  EXPECT_TRUE(scene.objects[0].mesh_path.empty());
+  expect_error("[[object]]\nshape = \"mesh\"\nmesh = \"builtin:teapot\"\n", 3, "object[0].mesh", "builtin:teapot");
 }
 
 }  // namespace
