@@ -25,12 +25,6 @@ bool parse_number(const std::string& text, T& out) {
   const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), out);
   return ec == std::errc() && end == text.data() + text.size();
 }
-
-bool is_square(int n) {
-  for (int i = 1; i * i <= n; ++i)
-    if (i * i == n) return true;
-  return false;
-}
 }  // namespace
 
 int run_simulate(const Args& args) {
@@ -57,7 +51,7 @@ int run_simulate(const Args& args) {
       ok = parse_number(value, seed);
       options.seed = seed;
     } else if (key == "--threads") ok = parse_number(value, options.threads) && options.threads > 0;
-    else if (key == "--samples") ok = parse_number(value, samples) && samples > 0 && is_square(samples);
+    else if (key == "--samples") ok = parse_number(value, samples) && sim::samples_per_axis(samples) > 0;
     else {
       fmt::print(stderr, "arpipe simulate: unknown option {}\n{}", key, kUsage);
       return 2;

@@ -3,11 +3,9 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cmath>
 #include <thread>
 
 #include "capture/sim/exposure_control.h"
-#include "capture/sim/shutter_pose_table.h"
 
 namespace arpipe::sim {
 
@@ -22,18 +20,16 @@ FrameRenderer::FrameRenderer(const CameraRayGrid& rays, int width, int height, i
       width_(width),
       height_(height),
       samples_per_pixel_(samples_per_pixel),
-      samples_per_axis_(int(std::lround(std::sqrt(double(samples_per_pixel))))),
+      samples_per_axis_(samples_per_axis(samples_per_pixel)),
       seed_(seed),
       threads_(threads > 0 ? threads : int(std::clamp(std::thread::hardware_concurrency(), 1u, 64u))) {}
 
-void FrameRenderer::render(const SceneShader& shader, const CameraTrajectory& trajectory, const FrameMetadata& meta,
+void FrameRenderer::render(const SceneShader& shader, const ShutterPoseTable& poses, const FrameMetadata& meta,
                            double trajectory_time_s, uint64_t frame_index, RadianceImage& out) const {
   out.width = width_;
   out.height = height_;
   out.rgb.assign(size_t(width_) * height_ * 3, 0.0f);
   const double exposure_s = meta.exposure_ns * 1e-9;
-  const double window_s = (meta.exposure_ns + meta.readout_ns) * 1e-9;
-  const ShutterPoseTable poses(trajectory, trajectory_time_s, trajectory_time_s + window_s);
   const int spp = samples_per_pixel_, n = samples_per_axis_;
 
   std::atomic<int> next_row{0};

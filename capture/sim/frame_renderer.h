@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "capture/sim/camera_ray_grid.h"
-#include "capture/sim/camera_trajectory.h"
 #include "capture/sim/scene_shader.h"
+#include "capture/sim/shutter_pose_table.h"
 #include "core/frame.h"
 
 namespace arpipe::sim {
@@ -29,8 +29,9 @@ class FrameRenderer {
   // samples_per_pixel must be a square; threads: 0 for one per core.
   FrameRenderer(const CameraRayGrid& rays, int width, int height, int samples_per_pixel, uint64_t seed, int threads = 0);
 
-  // trajectory_time_s: the trajectory's time at meta.exposure_start_ns.
-  void render(const SceneShader& shader, const CameraTrajectory& trajectory, const FrameMetadata& meta,
+  // poses: the camera over this frame's exposure window; trajectory_time_s: the trajectory's time
+  // at meta.exposure_start_ns.
+  void render(const SceneShader& shader, const ShutterPoseTable& poses, const FrameMetadata& meta,
               double trajectory_time_s, uint64_t frame_index, RadianceImage& out) const;
 
  private:

@@ -6,6 +6,8 @@
 
 namespace arpipe::sim {
 
+namespace {
+
 RayPose ray_pose(const SE3& T_cam_world) {
   const SE3 T_world_cam = T_cam_world.inverse();
   RayPose pose;
@@ -15,6 +17,8 @@ RayPose ray_pose(const SE3& T_cam_world) {
   }
   return pose;
 }
+
+}  // namespace
 
 ShutterPoseTable::ShutterPoseTable(const CameraTrajectory& trajectory, double start_s, double end_s, int intervals)
     : start_s_(start_s), step_s_(end_s > start_s ? (end_s - start_s) / intervals : 0.0) {

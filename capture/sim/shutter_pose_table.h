@@ -32,6 +32,4 @@ class ShutterPoseTable {
   std::vector<RayPose> entries_;
 };
 
-RayPose ray_pose(const SE3& T_cam_world);
-
 }  // namespace arpipe::sim

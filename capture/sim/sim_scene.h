@@ -165,6 +165,9 @@ struct SimCamera {
   SimSensor sensor;
 };
 
+// sqrt(samples_per_pixel) when it is a perfect square of at least 1, else 0.
+int samples_per_axis(int samples_per_pixel);
+
 struct SimRender {
   int samples_per_pixel = 16;  // a square number: stratified sqrt x sqrt in the pixel, stratified in time
   int frames = 30;             // default for `arpipe simulate` without --frames

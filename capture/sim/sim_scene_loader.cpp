@@ -422,8 +422,7 @@ SimRender read_render(const Section& s) {
   s.allow({"samples_per_pixel", "frames", "seed", "write_linear"});
   SimRender render;
   render.samples_per_pixel = static_cast<int>(s.integer("samples_per_pixel", render.samples_per_pixel, 1, 65536));
-  const int root = static_cast<int>(std::lround(std::sqrt(render.samples_per_pixel)));
-  if (root * root != render.samples_per_pixel)
+  if (samples_per_axis(render.samples_per_pixel) == 0)
     s.fail("samples_per_pixel", "a perfect square (1, 4, 9, 16, ...: a sqrt x sqrt grid in the pixel)",
            fmt::format("{}", render.samples_per_pixel));
   render.frames = static_cast<int>(s.integer("frames", render.frames, 1, std::numeric_limits<int>::max()));

@@ -18,6 +18,7 @@
 #include "capture/sim/frame_renderer.h"
 #include "capture/sim/scene_shader.h"
 #include "capture/sim/sensor_model.h"
+#include "capture/sim/shutter_pose_table.h"
 #include "core/image/pixel_convert.h"
 
 namespace arpipe::sim {
@@ -72,12 +73,12 @@ GroundTruthFrame ground_truth(const SimScene& scene, const CameraTrajectory& tra
   truth.T_cam_world_end = trajectory.T_cam_world(start + (meta.exposure_ns + meta.readout_ns) * 1e-9);
   if (meta.readout_ns > 0) {
     const int height = camera.model.height();
-    for (int row = 0; row < height; row = (row + kGroundTruthRowStride < height || row == height - 1)
-                                                ? row + kGroundTruthRowStride
-                                                : height - 1) {
+    std::vector<int> rows;
+    for (int row = 0; row < height; row += kGroundTruthRowStride) rows.push_back(row);
+    if (rows.back() != height - 1) rows.push_back(height - 1);
+    for (int row : rows) {
       const double mid = start + row_exposure_start_s(meta, row, height) + meta.exposure_ns * 0.5e-9;
       truth.rows.push_back({row, trajectory.T_cam_world(mid)});
-      if (row == height - 1) break;
     }
   }
   truth.lights = lights;
@@ -184,7 +185,8 @@ SimulateSummary simulate(const SimScene& scene, const SimulateOptions& options) 
     const SensorExposure exposure{meta.exposure_ns * 1e-9, meta.analogue_gain, meta.digital_gain};
     const double start_s = trajectory_time_s(camera, meta.exposure_start_ns);
 
-    renderer.render(camera_world, trajectory, meta, start_s, index, radiance);
+    const ShutterPoseTable poses(trajectory, start_s, start_s + (meta.exposure_ns + meta.readout_ns) * 1e-9);
+    renderer.render(camera_world, poses, meta, start_s, index, radiance);
     GroundTruthFrame truth = ground_truth(scene, trajectory, meta, lights);
     if (scene.render.write_linear) {
       truth.linear_image = fmt::format("linear_{:06d}.pfm", k);
@@ -193,7 +195,7 @@ SimulateSummary simulate(const SimScene& scene, const SimulateOptions& options) 
     writer.append(to_frame(expose(radiance, sensor, exposure, seed, index), width, height, camera.pixel_format, meta),
                   truth);
     if (composite_world) {
-      renderer.render(*composite_world, trajectory, meta, start_s, index, composite_radiance);
+      renderer.render(*composite_world, poses, meta, start_s, index, composite_radiance);
       composite_writer->append(
           to_frame(expose(composite_radiance, sensor, exposure, seed, index), width, height, PixelFormat::RGB24, meta),
           truth);
@@ -209,7 +211,6 @@ SimulateSummary simulate(const SimScene& scene, const SimulateOptions& options) 
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   summary.setup_seconds = setup_seconds;
   summary.wrote_composite = composite_world.has_value();
-  summary.ray_grid_error_px = rays.measured_error_px();
   return summary;
 }
 

@@ -32,7 +32,6 @@ struct SimulateSummary {
   double seconds = 0;          // wall time in all
   double setup_seconds = 0;    // of which loading assets, building the Embree scenes and the ray grid
   bool wrote_composite = false;
-  double ray_grid_error_px = 0;  // the camera ray grid's measured interpolation error
 };
 
 // Throws AssetError (a scene asset), RecordingError (writing), std::invalid_argument (options).
