@@ -19,6 +19,15 @@ add_library(mrcal::mrcal UNKNOWN IMPORTED)
 set_target_properties(mrcal::mrcal PROPERTIES IMPORTED_LOCATION ${MRCAL_LIBRARY}
   INTERFACE_INCLUDE_DIRECTORIES ${MRCAL_INCLUDE_DIR})
 
+# mrgingham (chessboard corners, square boards) ships neither pkg-config nor CMake files either.
+find_library(MRGINGHAM_LIBRARY mrgingham REQUIRED)
+find_path(MRGINGHAM_INCLUDE_DIR mrgingham/mrgingham.hh REQUIRED)
+add_library(mrgingham::mrgingham UNKNOWN IMPORTED)
+set_target_properties(mrgingham::mrgingham PROPERTIES IMPORTED_LOCATION ${MRGINGHAM_LIBRARY}
+  INTERFACE_INCLUDE_DIRECTORIES ${MRGINGHAM_INCLUDE_DIR})
+# Eigen: dense linear algebra for the calibration's uncertainty (header-only).
+find_package(Eigen3 3.3 REQUIRED NO_MODULE)
+
 # tinygltf is header-only in Debian (tiny_gltf.h); it needs stb and nlohmann json.
 find_path(TINYGLTF_INCLUDE_DIR tiny_gltf.h PATH_SUFFIXES tinygltf REQUIRED)
 

@@ -8,6 +8,7 @@ packages=(
   build-essential cmake pkg-config ninja-build git
   # core
   libmrcal-dev libdogleg-dev libapriltag-dev libopencv-dev libglm-dev
+  libmrgingham-dev libeigen3-dev libsuitesparse-dev
   libtomlplusplus-dev nlohmann-json3-dev libsystemd-dev libfmt-dev
   # render: EGL + GLES 3 on Mesa (llvmpipe when there is no GPU)
   libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri libgbm1

@@ -1,0 +1,26 @@
+// One image's view of the calibration board: the pixel of every observed point (or none), in the
+// board's point order, with the weight mrcal gives it.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/geometry/vec.h"
+
+namespace arpipe::calib {
+
+struct BoardObservation {
+  std::string image;          // file name or "recording frame N": what messages and reports show
+  int width = 0;              // size of the image it came from
+  int height = 0;
+  // One entry per board point (CalibrationBoard::point order). weight <= 0 marks a point that was
+  // not seen (partial board) or, after the solve, an outlier. Weight is 1/(relative noise):
+  // 1 at full resolution, 2^-level for a corner found at pyramid level `level`.
+  std::vector<Vec2> pixels;
+  std::vector<double> weights;
+  std::string detector;       // "mrgingham", "findChessboardCornersSB", "apriltag"
+
+  int seen_count() const;
+};
+
+}  // namespace arpipe::calib

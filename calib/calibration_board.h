@@ -1,0 +1,55 @@
+// A calibration board as described by configs/boards/*.toml: what is printed, and where its
+// observed points (the ones mrcal's solve sees) sit in the board's own frame.
+#pragma once
+
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "core/geometry/vec.h"
+
+namespace arpipe::calib {
+
+// Bad board file; what() reads "FILE:LINE:COL: key: what was wrong" where the place is known.
+class BoardError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+enum class BoardKind {
+  chessboard,    // observed points: the inner corners
+  apriltag_grid  // observed points: the tag centres (see docs/CALIBRATION.md for why not the corners)
+};
+
+struct CalibrationBoard {
+  std::string name;         // from the file's stem
+  BoardKind kind = BoardKind::chessboard;
+  // The grid of observed points, in mrcal's terms height_n x width_n: for a chessboard the inner
+  // corners (squares - 1 each way), for an AprilTag grid the tags.
+  int rows = 0;
+  int cols = 0;
+  double spacing_m = 0;     // between neighbouring observed points: square edge, or tag pitch
+  // AprilTag grid only.
+  std::string family;       // libapriltag family name, e.g. "tag36h11"
+  double tag_size_m = 0;    // black-border edge of one tag
+  int first_id = 0;         // id of the tag at row 0, col 0; ids run along rows: id = first_id + row*cols + col
+
+  int point_count() const { return rows * cols; }
+  // Point (row r, col c) at index r*cols + c sits at (c*spacing, r*spacing, 0): mrcal's layout,
+  // x along a row, y down the rows (mrcal.c, "calibration object" geometry).
+  Vec3 point(int row, int col) const { return {col * spacing_m, row * spacing_m, 0.0}; }
+  std::vector<Vec3> points() const;
+};
+
+// Reads a board file. Keys (all required unless noted):
+//   kind = "chessboard" | "apriltag_grid"
+//   chessboard:    inner_corners = [rows, cols], square_m
+//   apriltag_grid: tags = [rows, cols], tag_size_m, tag_spacing_m (gap between tags), family
+//                  (default "tag36h11"), first_id (default 0)
+//   description (optional string)
+// Unknown keys are errors. Throws BoardError.
+CalibrationBoard load_board(const std::filesystem::path& path);
+CalibrationBoard parse_board(const std::string& text, const std::string& source_name);
+
+}  // namespace arpipe::calib
