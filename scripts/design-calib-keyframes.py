@@ -1,0 +1,102 @@
+#!/usr/bin/python3
+"""Chooses the camera keyframes of configs/sim/calib-board.toml: views in which the whole board
+(white margin included) stays inside the image of the scene's lens while its corners reach into
+every corner and edge of the image, as mrcal's choreography asks (closeups, tilts up to ~45 degrees,
+the whole imager covered). Prints the [[trajectory.keyframe]] tables. Needs python3-mrcal.
+
+Usage: scripts/design-calib-keyframes.py [--seed N] [--views N]
+"""
+import argparse
+
+import mrcal
+import numpy as np
+
+W, H = 640, 480
+LENS = "LENSMODEL_OPENCV8"
+INTRINSICS = np.array([520.0, 521.5, 323.0, 237.0, -0.28, 0.11, 0.0005, -0.0004, -0.02, 0.04, 0.01, 0.0])
+# Inner corners (9 x 13, 20 mm) and the paper's outline (one white square of margin) in the world.
+CORNERS = np.array([[-0.12 + 0.02 * i, 0.08 - 0.02 * j, 0.0] for j in range(9) for i in range(13)])
+EDGE = np.linspace(-1, 1, 21)
+OUTLINE = np.array([[x * 0.16, y * 0.12, 0.0] for x in EDGE for y in (-1, 1)] +
+                   [[x * 0.16, y * 0.12, 0.0] for y in EDGE for x in (-1, 1)])
+
+
+def camera_rotation(position, look_at, roll):
+    """Columns x, y (down), z (forward) of the camera in the world, as the simulator builds them."""
+    z = look_at - position
+    z /= np.linalg.norm(z)
+    up = np.array([0.0, 1.0, 0.0])
+    y = -(up - z * (up @ z))
+    y /= np.linalg.norm(y)
+    x = np.cross(y, z)
+    c, s = np.cos(roll), np.sin(roll)
+    return np.column_stack([c * x + s * y, c * y - s * x, z])
+
+
+def project(points, position, R):
+    p_cam = (points - position) @ R
+    if np.any(p_cam[:, 2] < 0.05):
+        return None
+    return mrcal.project(p_cam, LENS, INTRINSICS)
+
+
+def inside(q, margin):
+    return np.all((q[:, 0] > margin) & (q[:, 0] < W - 1 - margin) & (q[:, 1] > margin) & (q[:, 1] < H - 1 - margin))
+
+
+def random_view(rng):
+    look_at = np.array([rng.uniform(-0.2, 0.2), rng.uniform(-0.17, 0.17), 0.0])
+    tilt = np.radians(rng.uniform(5, 45))
+    azimuth = rng.uniform(0, 2 * np.pi)
+    distance = rng.uniform(0.32, 0.65)
+    direction = np.array([np.sin(tilt) * np.cos(azimuth), np.sin(tilt) * np.sin(azimuth), np.cos(tilt)])
+    position = look_at + distance * direction
+    roll = np.radians(rng.uniform(-16, 16))
+    return position, look_at, roll
+
+
+def best_view(rng, target, tries):
+    best = None
+    for _ in range(tries):
+        position, look_at, roll = random_view(rng)
+        R = camera_rotation(position, look_at, roll)
+        outline = project(OUTLINE, position, R)
+        if outline is None or not inside(outline, 2):
+            continue
+        corners = project(CORNERS, position, R)
+        if not inside(corners, 11):
+            continue
+        # Reach: how close the board's corners come to the target image point; tilt breaks ties.
+        score = np.min(np.linalg.norm(corners - target, axis=1))
+        if best is None or score < best[0]:
+            best = (score, position, look_at, roll)
+    return best
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--seed", type=int, default=5)
+    parser.add_argument("--views", type=int, default=30)
+    parser.add_argument("--tries", type=int, default=15000)
+    args = parser.parse_args()
+    rng = np.random.default_rng(args.seed)
+    corners = [(0, 0), (W - 1, 0), (0, H - 1), (W - 1, H - 1)]
+    edges = [(W / 2, 0), (W / 2, H - 1), (0, H / 2), (W - 1, H / 2)]
+    targets = corners * 3 + edges * 2 + [(W / 2, H / 2)] * 4
+    while len(targets) < args.views:
+        targets.append((rng.uniform(0, W - 1), rng.uniform(0, H - 1)))
+    targets = targets[: args.views]
+    order = rng.permutation(len(targets))  # neighbouring keyframes far apart: no shared blur
+    for frame, index in enumerate(order):
+        score, position, look_at, roll = best_view(rng, np.array(targets[index], float), args.tries)
+        print(f"[[trajectory.keyframe]]  # reaches {score:.0f} px from image point "
+              f"({targets[index][0]:.0f}, {targets[index][1]:.0f})")
+        print(f"time_s = {frame * 0.5:.1f}")
+        print(f"position = [{position[0]:.3f}, {position[1]:.3f}, {position[2]:.3f}]")
+        print(f"look_at = [{look_at[0]:.3f}, {look_at[1]:.3f}, 0.000]")
+        print("up = [0.0, 1.0, 0.0]")
+        print(f"roll_deg = {np.degrees(roll):.0f}")
+
+
+if __name__ == "__main__":
+    main()
