@@ -16,6 +16,11 @@ commands:
   simulate --scene FILE --out DIR [--frames N] [--seed S] [--threads N] [--samples N]
                                      render a simulator scene (configs/sim/) into a
                                      recording with exact ground truth
+  calib (--images GLOB | --recording DIR) --board FILE --out CAMERA.cameramodel [--lensmodel NAME]
+                                     calibrate a camera's lens with mrcal from views of a
+                                     board (configs/boards/), with a report
+  board FILE --out BOARD.png [--dpi N]
+                                     draw a board file's printable picture
   config --defaults                  print a config with every key at its default
   config --check FILE                validate a config file
 )";
@@ -34,6 +39,8 @@ int main(int argc, char** argv) {
   if (command == "replay") return arpipe::run_replay(args);
   if (command == "simulate") return arpipe::run_simulate(args);
   if (command == "config") return arpipe::run_config(args);
+  if (command == "calib") return arpipe::run_calib(args);
+  if (command == "board") return arpipe::run_board(args);
   std::fprintf(stderr, "arpipe: unknown command '%s'\n%s", command.c_str(), kUsage);
   return 2;
 }
