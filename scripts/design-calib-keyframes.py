@@ -44,51 +44,74 @@ def inside(q, margin):
     return np.all((q[:, 0] > margin) & (q[:, 0] < W - 1 - margin) & (q[:, 1] > margin) & (q[:, 1] < H - 1 - margin))
 
 
-def random_view(rng):
-    look_at = np.array([rng.uniform(-0.2, 0.2), rng.uniform(-0.17, 0.17), 0.0])
+def random_view(rng, distances):
+    look_at = np.array([rng.uniform(-0.3, 0.3), rng.uniform(-0.25, 0.25), 0.0])
     tilt = np.radians(rng.uniform(5, 45))
     azimuth = rng.uniform(0, 2 * np.pi)
-    distance = rng.uniform(0.32, 0.65)
+    distance = rng.uniform(*distances)
     direction = np.array([np.sin(tilt) * np.cos(azimuth), np.sin(tilt) * np.sin(azimuth), np.cos(tilt)])
     position = look_at + distance * direction
     roll = np.radians(rng.uniform(-16, 16))
     return position, look_at, roll
 
 
-def best_view(rng, target, tries):
+def score_view(position, look_at, roll, target):
+    """How close the board's inner corners come to the target image point, or None when the
+    board (white margin included) is not wholly inside the image."""
+    R = camera_rotation(position, look_at, roll)
+    outline = project(OUTLINE, position, R)
+    if outline is None or not inside(outline, 2):
+        return None
+    corners = project(CORNERS, position, R)
+    if not inside(corners, 11):
+        return None
+    return np.min(np.linalg.norm(corners - target, axis=1))
+
+
+def best_view(rng, target, tries, distances):
     best = None
     for _ in range(tries):
-        position, look_at, roll = random_view(rng)
-        R = camera_rotation(position, look_at, roll)
-        outline = project(OUTLINE, position, R)
-        if outline is None or not inside(outline, 2):
-            continue
-        corners = project(CORNERS, position, R)
-        if not inside(corners, 11):
-            continue
-        # Reach: how close the board's corners come to the target image point; tilt breaks ties.
-        score = np.min(np.linalg.norm(corners - target, axis=1))
-        if best is None or score < best[0]:
+        position, look_at, roll = random_view(rng, distances)
+        score = score_view(position, look_at, roll, target)
+        if score is not None and (best is None or score < best[0]):
             best = (score, position, look_at, roll)
+    # Then creep towards the target: small random moves of the camera that keep the board inside.
+    step = 0.02
+    for _ in range(tries // 4):
+        _, position, look_at, roll = best
+        moved = (position + rng.normal(0, step, 3), look_at + np.append(rng.normal(0, step, 2), 0.0),
+                 roll + rng.normal(0, 0.02))
+        distance = np.linalg.norm(moved[0] - moved[1])
+        tilt = np.degrees(np.arccos((moved[0] - moved[1])[2] / distance))
+        if not (distances[0] <= distance <= distances[1] and 5 <= tilt <= 45 and abs(moved[2]) <= np.radians(16)):
+            continue
+        score = score_view(*moved, target)
+        if score is not None and score < best[0]:
+            best = (score, *moved)
     return best
 
 
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--seed", type=int, default=5)
-    parser.add_argument("--views", type=int, default=30)
-    parser.add_argument("--tries", type=int, default=15000)
+    parser.add_argument("--views", type=int, default=60)
+    parser.add_argument("--tries", type=int, default=3000)
+    parser.add_argument("--corner-distance", type=float, nargs=2, default=(0.5, 1.0))
     args = parser.parse_args()
     rng = np.random.default_rng(args.seed)
     corners = [(0, 0), (W - 1, 0), (0, H - 1), (W - 1, H - 1)]
     edges = [(W / 2, 0), (W / 2, H - 1), (0, H / 2), (W - 1, H / 2)]
-    targets = corners * 3 + edges * 2 + [(W / 2, H / 2)] * 4
+    targets = (corners * 3 + edges * 2 + [(W / 2, H / 2)] * 4) * max(1, args.views // 30)
     while len(targets) < args.views:
         targets.append((rng.uniform(0, W - 1), rng.uniform(0, H - 1)))
     targets = targets[: args.views]
     order = rng.permutation(len(targets))  # neighbouring keyframes far apart: no shared blur
     for frame, index in enumerate(order):
-        score, position, look_at, roll = best_view(rng, np.array(targets[index], float), args.tries)
+        # Close-ups pin the focal length and the distortion; in the image corners the whole board
+        # (white margin included) only fits further away, where it is smaller, and the corners are
+        # where a lens model is otherwise extrapolated.
+        distances = tuple(args.corner_distance) if targets[index] in corners else (0.32, 0.65)
+        score, position, look_at, roll = best_view(rng, np.array(targets[index], float), args.tries, distances)
         print(f"[[trajectory.keyframe]]  # reaches {score:.0f} px from image point "
               f"({targets[index][0]:.0f}, {targets[index][1]:.0f})")
         print(f"time_s = {frame * 0.5:.1f}")

@@ -118,7 +118,7 @@ int run_calib(const Args& args) {
     const calib::CalibrationReport report = calib::make_report(result, found.images, found.without_board);
 
     // The model last: a failure writing the extras leaves no model that looks finished.
-    calib::write_corners_vnl(beside(out, ".corners.vnl"), result.observations, board);
+    calib::write_corners_vnl(beside(out, ".corners.vnl"), found.views, board);  // as detected: mrcal redoes its own outlier rejection
     write_text(beside(out, ".report.txt"), calib::report_text(report));
     write_text(beside(out, ".report.json"), calib::report_json(report));
     calib::write_residual_image(beside(out, ".residuals.png"), result);

@@ -226,8 +226,8 @@ TEST(SimSceneLoaderExamples, CalibBoardShowsTheWholeBoardAllOverTheImage) {
   EXPECT_EQ(scene.camera.fps, 2.0);
   EXPECT_TRUE(scene.camera.sensor.noise);
   const auto& keys = scene.trajectory.keyframes;
-  ASSERT_EQ(keys.size(), 30u);
-  EXPECT_EQ(scene.render.frames, 30);
+  ASSERT_EQ(keys.size(), 60u);
+  EXPECT_EQ(scene.render.frames, 60);
   std::set<std::pair<int, int>> cells;  // 3x3 regions of the image where the board's centre lies
   for (size_t i = 0; i < keys.size(); ++i) {
     EXPECT_DOUBLE_EQ(keys[i].time_s, double(i) / scene.camera.fps) << "keyframe " << i << " is not frame " << i;
