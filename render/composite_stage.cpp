@@ -1,5 +1,6 @@
-// The composite stage: puts the virtual layer over the camera frame into ctx.output (RGB24), in
-// linear light with premultiplied alpha, doing GL work only inside the layer's drawn rectangle.
+// The composite stage: puts the virtual layer over the camera frame (undistorted first when
+// render.lens = "undistort") into ctx.output (RGB24), in linear light with premultiplied alpha,
+// doing GL work only inside the layer's drawn rectangle.
 #include "render/composite_stage.h"
 
 #include <fmt/format.h>
@@ -47,10 +48,12 @@ void main() {
 }
 )glsl";
 
+// The camera frame as it was, seen through the camera's own lens.
 void pass_through(FrameContext& ctx) {
   ctx.output = Frame::allocate(PixelFormat::RGB24, ctx.camera.width, ctx.camera.height);
   ctx.output.meta = ctx.camera.meta;
   to_rgb24(ctx.camera, ctx.output.data);
+  ctx.output_camera_model = ctx.camera_model;
 }
 
 }  // namespace
@@ -66,7 +69,8 @@ CompositeStage::~CompositeStage() {
   output_texture_.reset();
 }
 
-void CompositeStage::configure(const Config&) {
+void CompositeStage::configure(const Config& config) {
+  const LensMode lens = parse_lens_mode(config.render.lens);
   session_->make_current();
   if (program_.id() == 0) {
     program_ = GlProgram("compositing", kVertexShader, kFragmentShader);
@@ -75,14 +79,34 @@ void CompositeStage::configure(const Config&) {
     glUniform1i(program_.uniform("u_virtual_layer"), 0);
     glUniform1i(program_.uniform("u_camera"), 1);
   }
+  lens_ = lens;
   last_error_.clear();
+}
+
+void CompositeStage::camera_picture(FrameContext& ctx) {
+  if (lens_ != LensMode::Undistort) {
+    pass_through(ctx);
+    return;
+  }
+  const std::shared_ptr<const LensUndistortion> undistortion =
+      undistortions_.get(ctx.camera_model, [](const CameraModel& model) { return LensUndistortion(model); });
+  if (ctx.camera.width != ctx.camera_model->width() || ctx.camera.height != ctx.camera_model->height())
+    throw RenderError(fmt::format("the camera frame is {}x{} but the camera model is for {}x{}", ctx.camera.width,
+                                  ctx.camera.height, ctx.camera_model->width(), ctx.camera_model->height()));
+  if (distorted_.width != ctx.camera.width || distorted_.height != ctx.camera.height)
+    distorted_ = Frame::allocate(PixelFormat::RGB24, ctx.camera.width, ctx.camera.height);
+  to_rgb24(ctx.camera, distorted_.data);
+  ctx.output = Frame::allocate(PixelFormat::RGB24, ctx.camera.width, ctx.camera.height);
+  ctx.output.meta = ctx.camera.meta;
+  undistortion->apply(distorted_, ctx.output);
+  ctx.output_camera_model = undistortion->pinhole_core();
 }
 
 void CompositeStage::process(FrameContext& ctx) noexcept {
   const auto start = std::chrono::steady_clock::now();
   try {
     if (!ctx.virtual_layer_drawn) {
-      pass_through(ctx);
+      camera_picture(ctx);
       ctx.record_timing(std::string(name()), milliseconds_since(start), "nothing virtual drawn: pass-through");
       return;
     }
@@ -118,16 +142,16 @@ void CompositeStage::ensure_targets(int width, int height) {
 
 void CompositeStage::composite(FrameContext& ctx) {
   const int width = ctx.camera.width, height = ctx.camera.height;
-  VirtualLayer& layer = session_->layer();
-  const PixelRect rect = session_->drawn_rect;
-  if (layer.width() != width || layer.height() != height)
-    throw RenderError(fmt::format("the virtual layer is {}x{} but the camera frame is {}x{}", layer.width(),
-                                  layer.height(), width, height));
+  const RenderSession::DrawnLayer& layer = session_->drawn;
+  const PixelRect rect = layer.rect;
+  if (layer.width != width || layer.height != height)
+    throw RenderError(fmt::format("the virtual layer is {}x{} but the camera frame is {}x{}", layer.width,
+                                  layer.height, width, height));
   if (rect.empty() || rect.x < 0 || rect.y < 0 || rect.right() > width || rect.bottom() > height)
     throw RenderError("the virtual layer's drawn rectangle lies outside the frame");
 
-  // Everything outside the rectangle is the camera frame unchanged; the rectangle is overwritten.
-  pass_through(ctx);
+  // Everything outside the rectangle is the camera picture unchanged; the rectangle is overwritten.
+  camera_picture(ctx);
   session_->make_current();
   ensure_targets(width, height);
 
@@ -143,7 +167,7 @@ void CompositeStage::composite(FrameContext& ctx) {
   glPixelStorei(GL_UNPACK_SKIP_PIXELS, 0);
   glPixelStorei(GL_UNPACK_SKIP_ROWS, 0);
   glActiveTexture(GL_TEXTURE0);
-  glBindTexture(GL_TEXTURE_2D, layer.texture());
+  glBindTexture(GL_TEXTURE_2D, layer.texture);
 
   glBindFramebuffer(GL_FRAMEBUFFER, output_framebuffer_.get());
   glViewport(0, 0, width, height);

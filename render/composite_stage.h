@@ -1,5 +1,6 @@
-// The composite stage: puts the virtual layer over the camera frame into ctx.output (RGB24), in
-// linear light with premultiplied alpha, doing GL work only inside the layer's drawn rectangle.
+// The composite stage: puts the virtual layer over the camera frame (undistorted first when
+// render.lens = "undistort") into ctx.output (RGB24), in linear light with premultiplied alpha,
+// doing GL work only inside the layer's drawn rectangle.
 #pragma once
 
 #include <cstdint>
@@ -10,6 +11,9 @@
 #include "core/pipeline/stage.h"
 #include "render/gl_objects.h"
 #include "render/gl_program.h"
+#include "render/lens_mode.h"
+#include "render/lens_undistortion.h"
+#include "render/per_model_cache.h"
 #include "render/render_session.h"
 
 namespace arpipe {
@@ -22,12 +26,15 @@ class CompositeStage final : public Stage {
   std::string_view name() const override { return "composite"; }
   // Compiles the shader once; the render stage (configured first) has made the context.
   void configure(const Config& config) override;
-  // ctx.output = the camera frame as RGB24 (the camera's sRGB bytes as they were) where nothing
-  // virtual is, and encode_srgb(V.rgb + (1 - V.a) * decode_srgb(camera)) inside the drawn
-  // rectangle. Without a virtual layer this frame, no GL at all: a CPU conversion only.
+  // ctx.output = the camera picture as RGB24 where nothing virtual is, and
+  // encode_srgb(V.rgb + (1 - V.a) * decode_srgb(camera)) inside the drawn rectangle. The camera
+  // picture is the camera's sRGB bytes as they were, or, with render.lens = "undistort", the frame
+  // undistorted to its pinhole core (on the CPU, every frame); ctx.output_camera_model says which.
+  // Without a virtual layer this frame, no GL at all. On an error: the camera frame as it was.
   void process(FrameContext& ctx) noexcept override;
 
  private:
+  void camera_picture(FrameContext& ctx);
   void composite(FrameContext& ctx);
   void ensure_targets(int width, int height);
 
@@ -41,6 +48,9 @@ class CompositeStage final : public Stage {
   int height_ = 0;
   std::vector<uint8_t> readback_;
   std::string last_error_;
+  LensMode lens_ = LensMode::Map;
+  PerModelCache<LensUndistortion> undistortions_;
+  Frame distorted_;  // the camera frame as RGB24 before undistortion, reused
 };
 
 }  // namespace arpipe

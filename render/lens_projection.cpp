@@ -65,8 +65,9 @@ bool lens_model_supported(const std::string& lensmodel) {
 void check_lens_model_supported(const CameraModel& model) {
   if (!lens_model_supported(model.lensmodel()))
     throw RenderError(fmt::format(
-        "lens model {} is not yet supported by the renderer (it projects through LENSMODEL_PINHOLE, "
-        "LENSMODEL_OPENCV4, LENSMODEL_OPENCV5 and LENSMODEL_OPENCV8)",
+        "lens model {} is not supported by render.lens = \"vertex\" (it projects through LENSMODEL_PINHOLE, "
+        "LENSMODEL_OPENCV4, LENSMODEL_OPENCV5 and LENSMODEL_OPENCV8); render.lens = \"map\" draws through any "
+        "lens mrcal can unproject",
         model.lensmodel()));
 }
 

@@ -23,9 +23,9 @@ struct LensUniforms {
   int height = 0;
 };
 
-// Whether the vertex shader can project through this mrcal lens model.
+// Whether the vertex shader can project through this mrcal lens model (render.lens = "vertex").
 bool lens_model_supported(const std::string& lensmodel);
-// Throws RenderError naming the model when the renderer cannot project through it yet.
+// Throws RenderError naming the model when the vertex shader cannot project through it.
 void check_lens_model_supported(const CameraModel& model);
 // Throws RenderError as above.
 LensUniforms lens_uniforms(const CameraModel& model);

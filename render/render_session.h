@@ -1,6 +1,8 @@
 // What the render and composite stages share: the one EGL context (made by the first configure,
-// on the processing thread) and the virtual layer with the rectangle drawn into it this frame.
+// on the processing thread), the layer that objects are drawn into, and what was drawn this frame.
 #pragma once
+
+#include <GLES3/gl3.h>
 
 #include <memory>
 #include <string>
@@ -28,10 +30,20 @@ class RenderSession {
   bool try_make_current() const noexcept;
 
   const EglContext& context() const { return *context_; }
+  // Where the objects are drawn: at the camera image's size, or the pinhole canvas's with
+  // render.lens = "map".
   VirtualLayer& layer() { return *layer_; }
 
-  // The part of the layer drawn for the current frame; meaningful when ctx.virtual_layer_drawn.
-  PixelRect drawn_rect;
+  // The virtual layer as the composite stage reads it this frame: a texture at the output image's
+  // size, linear with premultiplied alpha, image row v on GL row v, valid inside rect. It is the
+  // layer's own texture, or the lens warp's output. Meaningful when ctx.virtual_layer_drawn.
+  struct DrawnLayer {
+    GLuint texture = 0;
+    int width = 0;
+    int height = 0;
+    PixelRect rect;
+  };
+  DrawnLayer drawn;
 
  private:
   std::unique_ptr<EglContext> context_;

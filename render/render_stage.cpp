@@ -1,5 +1,6 @@
 // The render stage: draws the scene's virtual objects, seen from the tracked pose through the
-// calibrated lens, into the shared virtual layer (linear, premultiplied alpha, depth-tested).
+// calibrated lens (render.lens: warped canvas, per-vertex distortion, or the undistorted pinhole
+// core), into the shared virtual layer (linear, premultiplied alpha, depth-tested).
 #include "render/render_stage.h"
 
 #include <fmt/format.h>
@@ -11,6 +12,7 @@
 #include "core/pipeline/monotonic_clock.h"
 #include "render/gl_error.h"
 #include "render/lens_projection.h"
+#include "render/lens_undistortion.h"
 #include "render/projected_bounds.h"
 #include "render/render_errors.h"
 
@@ -71,6 +73,7 @@ RenderStage::RenderStage(std::shared_ptr<RenderSession> session) : session_(std:
 RenderStage::~RenderStage() {
   session_->try_make_current();
   objects_.clear();
+  warp_pass_.reset();
   program_ = GlProgram();
 }
 
@@ -90,8 +93,15 @@ void RenderStage::configure(const Config& config) {
   settings.light_direction = light_length > 0 ? (1.0 / light_length) * config.render.light_direction : Vec3{0, 0, 1};
   settings.light_color = config.render.light_color;
   settings.ambient = config.render.ambient;
+  settings.lens = parse_lens_mode(config.render.lens);
+  settings.lens_canvas_scale = config.render.lens_canvas_scale;
+
+  // The warp's shader is compiled here rather than on the first frame that needs it.
+  if (settings.lens == LensMode::Map && !warp_pass_)
+    warp_pass_ = std::make_unique<LensWarpPass>(session_->layer().color_format());
 
   objects_ = std::move(objects);
+  if (settings.lens_canvas_scale != settings_.lens_canvas_scale) warp_maps_.clear();
   settings_ = settings;
   last_error_.clear();
 }
@@ -132,27 +142,48 @@ void RenderStage::draw(FrameContext& ctx) {
   if (camera.width() != ctx.camera.width || camera.height() != ctx.camera.height)
     throw RenderError(fmt::format("the camera frame is {}x{} but the camera model is for {}x{}", ctx.camera.width,
                                   ctx.camera.height, camera.width(), camera.height()));
-  const LensUniforms lens = lens_uniforms(camera);
+  if (settings_.lens == LensMode::Vertex) check_lens_model_supported(camera);
+  // What the output picture sees: the camera's lens, or its pinhole core when the composite
+  // stage undistorts the camera frame.
+  std::shared_ptr<const CameraModel> pinhole_core;
+  if (settings_.lens == LensMode::Undistort)
+    pinhole_core = pinhole_cores_.get(ctx.camera_model, [](const CameraModel& model) {
+      check_lens_undistortable(model);
+      return CameraModel::pinhole(model.fx(), model.fy(), model.cx(), model.cy(), model.width(), model.height());
+    });
+  const CameraModel& image_camera = pinhole_core ? *pinhole_core : camera;
 
   struct Visible {
     const RenderObject* object;
     SE3 T_cam_object;
   };
   std::vector<Visible> visible;
-  PixelRect rect;
+  PixelRect rect;  // in the output image
   for (const RenderObject& object : objects_) {
     const SE3 T_cam_object = ctx.pose.T_cam_world * object.T_world_object;
-    if (std::optional<PixelRect> object_rect = projected_box_rect(camera, T_cam_object, object.bounds, kRectMarginPx)) {
+    if (std::optional<PixelRect> object_rect =
+            projected_box_rect(image_camera, T_cam_object, object.bounds, kRectMarginPx)) {
       rect = rect.united(*object_rect);
       visible.push_back({&object, T_cam_object});
     }
   }
   if (visible.empty()) return;
 
+  // "map": draw on the pinhole canvas, in the part of it that the output rectangle samples.
+  std::shared_ptr<const LensWarpMap> warp;
+  if (settings_.lens == LensMode::Map) {
+    warp = warp_maps_.get(ctx.camera_model, [scale = settings_.lens_canvas_scale](const CameraModel& model) {
+      return LensWarpMap(model, scale);
+    });
+    if (warp->identity()) warp.reset();  // a pinhole lens: the canvas is the image
+  }
+  const LensUniforms lens = warp ? lens_uniforms(warp->canvas().model()) : lens_uniforms(image_camera);
+  const PixelRect draw_rect = warp ? warp->canvas_rect_for(rect) : rect;
+
   session_->make_current();
   VirtualLayer& layer = session_->layer();
-  layer.ensure(camera.width(), camera.height(), settings_.msaa_samples);
-  layer.begin(rect);
+  layer.ensure(lens.width, lens.height, settings_.msaa_samples);
+  layer.begin(draw_rect);
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
   glDisable(GL_BLEND);
@@ -180,12 +211,19 @@ void RenderStage::draw(FrameContext& ctx) {
       glUniform4f(base_color, color[0], color[1], color[2], color[3]);
     });
   }
-  layer.resolve(rect);
+  layer.resolve(draw_rect);
   glDisable(GL_SCISSOR_TEST);
+  GLuint drawn_texture = layer.texture();
+  if (warp) {
+    if (!warp_pass_) warp_pass_ = std::make_unique<LensWarpPass>(layer.color_format());
+    warp_pass_->set_map(warp);
+    warp_pass_->run(layer.texture(), rect);
+    drawn_texture = warp_pass_->texture();
+  }
   // The work is queued until something waits for it; waiting here keeps the stage timings honest.
   glFinish();
   check_gl("drawing the virtual layer");
-  session_->drawn_rect = rect;
+  session_->drawn = {drawn_texture, camera.width(), camera.height(), rect};
   ctx.virtual_layer_drawn = true;
 }
 

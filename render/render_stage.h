@@ -1,5 +1,6 @@
 // The render stage: draws the scene's virtual objects, seen from the tracked pose through the
-// calibrated lens, into the shared virtual layer (linear, premultiplied alpha, depth-tested).
+// calibrated lens (render.lens: warped canvas, per-vertex distortion, or the undistorted pinhole
+// core), into the shared virtual layer (linear, premultiplied alpha, depth-tested).
 #pragma once
 
 #include <memory>
@@ -8,6 +9,10 @@
 
 #include "core/pipeline/stage.h"
 #include "render/gl_program.h"
+#include "render/lens_mode.h"
+#include "render/lens_warp_map.h"
+#include "render/lens_warp_pass.h"
+#include "render/per_model_cache.h"
 #include "render/render_objects.h"
 #include "render/render_session.h"
 
@@ -23,7 +28,9 @@ class RenderStage final : public Stage {
   // loads the meshes; throws RenderError, ConfigError or AssetError and then keeps the old setup.
   void configure(const Config& config) override;
   // Skips (ctx.virtual_layer_drawn = false, reason recorded) when rendering is off, there are no
-  // objects, the pose is not Tracking, or no object's box reaches into the image.
+  // objects, the pose is not Tracking, or no object's box reaches into the image; such frames do
+  // no GL work. With render.lens = "map" the first drawn frame of a camera model builds its warp
+  // map (mrcal, a few hundred ms at 640x480), kept for later frames.
   void process(FrameContext& ctx) noexcept override;
 
  private:
@@ -33,11 +40,16 @@ class RenderStage final : public Stage {
     Vec3 light_direction{0, 0, 1};
     Vec3 light_color{1, 1, 1};
     Vec3 ambient{0, 0, 0};
+    LensMode lens = LensMode::Map;
+    double lens_canvas_scale = 1.5;
   };
   void draw(FrameContext& ctx);
 
   std::shared_ptr<RenderSession> session_;  // first member: outlives the GL objects below
   GlProgram program_;
+  std::unique_ptr<LensWarpPass> warp_pass_;  // made by configure with render.lens = "map"
+  PerModelCache<LensWarpMap> warp_maps_;
+  PerModelCache<CameraModel> pinhole_cores_;  // render.lens = "undistort": what the output sees
   std::vector<RenderObject> objects_;
   Settings settings_;
   std::string last_error_;  // logged once per distinct message, not once per frame

@@ -8,7 +8,7 @@
 #include "capture/sinks/results_sink.h"
 #include "capture/sinks/y4m_sink.h"
 #include "core/track/tag_tracker.h"
-#include "render/lens_projection.h"
+#include "render/lens_mode.h"
 #include "render/render_stages.h"
 
 namespace arpipe {
@@ -40,12 +40,16 @@ StageFactory make_stage_factory() {
 
 std::unique_ptr<PipelineRunner> assemble_pipeline(const Config& config) {
   auto source = make_source(config);
-  // A lens the renderer cannot reproduce is a setup error, refused before streaming starts.
-  if (config.render.enabled && !config.render.objects.empty() && source->camera_model()) {
+  // A lens the renderer cannot reproduce in the configured render.lens mode is a setup error,
+  // refused before streaming starts. "undistort" changes the output even without objects.
+  const LensMode lens = parse_lens_mode(config.render.lens);
+  const bool renders = config.render.enabled && !config.render.objects.empty();
+  if ((renders || lens == LensMode::Undistort) && source->camera_model()) {
     try {
-      check_lens_model_supported(*source->camera_model());
+      check_lens_for_mode(*source->camera_model(), lens);
     } catch (const std::exception& e) {
-      throw ConfigError(fmt::format("{}: camera model: {}", source->describe(), e.what()));
+      throw ConfigError(fmt::format("{}: camera model: {} (render.lens = \"{}\")", source->describe(), e.what(),
+                                    lens_mode_name(lens)));
     }
   }
   auto sinks = make_sinks(config);

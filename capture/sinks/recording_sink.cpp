@@ -18,14 +18,16 @@ void RecordingSink::consume(const FrameContext& ctx) noexcept {
   if (ctx.output.empty() || failures_ > 0) return;  // a failed recording stays stopped, the rest goes on
   try {
     if (!writer_) {
-      if (!ctx.camera_model) throw RecordingError("no camera model for the recording");
+      // The lens of the output picture: the camera's, or its pinhole core when render.lens undistorts.
+      const auto& model = ctx.output_camera_model ? ctx.output_camera_model : ctx.camera_model;
+      if (!model) throw RecordingError("no camera model for the recording");
       RecordingInfo info;
       info.pixel_format = ctx.output.format;
       info.width = ctx.output.width;
       info.height = ctx.output.height;
       info.bytes_per_line = ctx.output.bytes_per_line;
       info.source = "arpiped composited output";
-      writer_ = std::make_unique<RecordingWriter>(config_.path, info, *ctx.camera_model);
+      writer_ = std::make_unique<RecordingWriter>(config_.path, info, *model);
     }
     Frame frame = ctx.output;
     frame.meta = ctx.camera.meta;

@@ -31,9 +31,11 @@ std::string ResultsSink::to_json_line(const FrameContext& ctx) {
     j["reprojection_rms_px"] = ctx.pose.reprojection_rms_px;
     j["ambiguous"] = ctx.pose.ambiguous;
     j["tags_used"] = ctx.pose.tags_used;
-    // Where the anchor (world origin, where the virtual object stands) lands in the image.
-    if (ctx.camera_model) {
-      if (auto px = ctx.camera_model->project(ctx.pose.T_cam_world * Vec3{0, 0, 0}))
+    // Where the anchor (world origin, where the virtual object stands) lands in the output image
+    // (undistorted when render.lens is "undistort").
+    const auto& model = ctx.output_camera_model ? ctx.output_camera_model : ctx.camera_model;
+    if (model) {
+      if (auto px = model->project(ctx.pose.T_cam_world * Vec3{0, 0, 0}))
         j["anchor_px"] = {(*px)[0], (*px)[1]};
     }
   }

@@ -286,7 +286,9 @@ void read_track(const ConfigReader& r, const toml::table& t, TrackConfig& out) {
 
 void read_render(const ConfigReader& r, const toml::table& t, RenderConfig& out) {
   const std::string p = "render.";
-  r.check_keys(t, p, {"enabled", "objects", "light_direction", "light_color", "ambient", "msaa_samples", "egl_platform"},
+  r.check_keys(t, p,
+               {"enabled", "objects", "light_direction", "light_color", "ambient", "msaa_samples", "egl_platform",
+                "lens", "lens_canvas_scale"},
                "[render]");
   r.read(t, p, "enabled", out.enabled);
   if (const toml::array* objects = r.array_of_tables(t, p, "objects")) {
@@ -316,6 +318,9 @@ void read_render(const ConfigReader& r, const toml::table& t, RenderConfig& out)
   if (out.msaa_samples != 0 && out.msaa_samples != 1 && out.msaa_samples != 2 && out.msaa_samples != 4)
     r.fail_got(*t.get("msaa_samples"), p + "msaa_samples", "one of 0, 1, 2, 4", fmt::format("{}", out.msaa_samples));
   r.read(t, p, "egl_platform", out.egl_platform, {"auto", "surfaceless", "device"});
+  r.read(t, p, "lens", out.lens, {"map", "vertex", "undistort"});
+  r.read(t, p, "lens_canvas_scale", out.lens_canvas_scale, [](double v) { return v >= 1 && v <= 4; },
+         "a number in [1, 4]");
 }
 
 void read_sinks(const ConfigReader& r, const toml::table& t, SinksConfig& out) {
@@ -558,6 +563,15 @@ std::string default_config_toml() {
   entry("ambient", vec(d.render.ambient), "linear RGB, >= 0");
   entry("msaa_samples", fmt::format("{}", d.render.msaa_samples), "0, 1, 2 or 4");
   entry("egl_platform", s(d.render.egl_platform), "\"auto\", \"surfaceless\" or \"device\"");
+  out += "# lens: how the virtual layer matches the real lens.\n"
+         "#   \"map\": draw with the lens's pinhole core on an enlarged canvas, warp through a per-pixel map\n"
+         "#          built once with mrcal (any lens mrcal can unproject, rays up to 75 degrees off axis)\n"
+         "#   \"vertex\": distort per vertex (PINHOLE, OPENCV4/5/8 only; straight edges stay straight)\n"
+         "#   \"undistort\": undistort the camera frame to the pinhole core instead and draw pinhole: the\n"
+         "#          output is an undistorted picture whose camera model is that pinhole core\n";
+  entry("lens", s(d.render.lens), "\"map\", \"vertex\" or \"undistort\"");
+  entry("lens_canvas_scale", f(d.render.lens_canvas_scale),
+        "\"map\": canvas pixels per core pixel, [1, 4]; finer edges, cost grows with its square");
   out += "\n# Virtual objects: one [[render.objects]] each, placed in the world (anchor) frame.\n";
   for (const SceneObject& object : d.render.objects) {
     out += "[[render.objects]]\n";

@@ -76,6 +76,18 @@ struct RenderConfig {
   Vec3 ambient{0.25, 0.25, 0.25};        // linear
   int msaa_samples = 4;
   std::string egl_platform = "auto";     // "auto", "surfaceless", "device"
+  // How the virtual layer matches the real lens (docs/ARCHITECTURE.md, "Lens-matched rendering"):
+  // "map": draw with the lens model's pinhole core on an enlarged canvas, then warp it through a
+  //   per-pixel map built once with mrcal (any lens mrcal can unproject, up to 75 degrees off axis);
+  // "vertex": distort per vertex in the vertex shader (PINHOLE and OPENCV4/5/8 only; edges between
+  //   vertices stay straight);
+  // "undistort": warp the camera frame to the pinhole core and draw pinhole: the output is an
+  //   undistorted picture, whose camera model is the pinhole core.
+  std::string lens = "map";
+  // "map" only: canvas pixels per pinhole-core pixel, in [1, 4]. 4x multisampling alone leaves a
+  // straight edge up to 1/8 canvas pixel off; a finer canvas divides that, at its square in fill
+  // and memory (tests/render/lens_matched_rendering_test.cpp measures both).
+  double lens_canvas_scale = 1.5;
 
   bool operator==(const RenderConfig&) const = default;
 };

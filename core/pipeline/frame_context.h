@@ -48,6 +48,9 @@ struct FrameContext {
   std::shared_ptr<const CameraModel> camera_model;
   PoseEstimate pose;
   Frame output;                                 // the composited frame, RGB24; empty until composed
+  // The lens that ctx.output is seen through: camera_model, or its pinhole core when render.lens
+  // is "undistort" (the output is then an undistorted picture). Set with ctx.output.
+  std::shared_ptr<const CameraModel> output_camera_model;
   bool virtual_layer_drawn = false;
   std::vector<StageTiming> timings;
   uint64_t input_index = 0;                     // position in the stream as the pipeline saw it

@@ -45,6 +45,8 @@ TEST(Config, DefaultsAreTheDocumentedOnes) {
   EXPECT_EQ(c.track.bundle[0].id, 0);
   EXPECT_EQ(c.track.bundle[0].size_m, 0.1);
   EXPECT_EQ(c.render.msaa_samples, 4);
+  EXPECT_EQ(c.render.lens, "map");
+  EXPECT_EQ(c.render.lens_canvas_scale, 1.5);
   EXPECT_EQ(c.pipeline.queue_depth, 4);
   EXPECT_EQ(c.pipeline.log_level, "info");
   // The default light direction is (0.3, -0.4, 1) made unit length.
@@ -67,9 +69,9 @@ TEST(Config, DefaultTomlReadsBackAsTheDefaultConfigAndListsEveryKey) {
         "[track]", "enabled = ", "family = ", "quad_decimate = ", "quad_sigma = ", "threads = ", "max_hamming = ",
         "min_decision_margin = ", "ambiguity_ratio = ", "[[track.bundle]]", "id = ", "size_m = ", "center_m = ",
         "yaw_deg = ", "[render]", "light_direction = ", "light_color = ", "ambient = ", "msaa_samples = ",
-        "egl_platform = ", "[[render.objects]]", "mesh = ", "position_m = ", "scale = ", "color = ", "[sinks.png]",
-        "dir = ", "every = ", "[sinks.y4m]", "[sinks.recording]", "[sinks.results]", "[pipeline]", "queue_depth = ",
-        "max_frames = ", "log_level = "})
+        "egl_platform = ", "lens = ", "lens_canvas_scale = ", "[[render.objects]]", "mesh = ", "position_m = ",
+        "scale = ", "color = ", "[sinks.png]", "dir = ", "every = ", "[sinks.y4m]", "[sinks.recording]",
+        "[sinks.results]", "[pipeline]", "queue_depth = ", "max_frames = ", "log_level = "})
     EXPECT_NE(text.find(std::string("\n") + line), std::string::npos) << line;
 }
 
@@ -112,6 +114,8 @@ light_color = [2.0, 1.5, 1.0]
 ambient = [0.1, 0.1, 0.2]
 msaa_samples = 2
 egl_platform = "surfaceless"
+lens = "undistort"
+lens_canvas_scale = 2
 
 [[render.objects]]
 mesh = "builtin:pyramid"
@@ -170,6 +174,8 @@ log_level = "debug"
   EXPECT_EQ(c.render.ambient, (Vec3{0.1, 0.1, 0.2}));
   EXPECT_EQ(c.render.msaa_samples, 2);
   EXPECT_EQ(c.render.egl_platform, "surfaceless");
+  EXPECT_EQ(c.render.lens, "undistort");
+  EXPECT_EQ(c.render.lens_canvas_scale, 2.0);
   ASSERT_EQ(c.render.objects.size(), 2u);
   EXPECT_EQ(c.render.objects[0].mesh, "builtin:pyramid");
   EXPECT_EQ(c.render.objects[0].position_m, (Vec3{0.0, 0.1, 0.02}));
@@ -250,6 +256,13 @@ TEST(Config, OutOfRangeValuesSayWhatWasExpected) {
   expect_error("[render]\nmsaa_samples = 3\n", {"test.toml:2:16:", "expected one of 0, 1, 2, 4, got 3"});
   expect_error("[render]\nmsaa_samples = 8\n", {"expected one of 0, 1, 2, 4, got 8"});
   expect_error("[render]\negl_platform = \"x11\"\n", {"'render.egl_platform' expected one of", "got \"x11\""});
+  expect_error("[render]\nlens = \"fisheye\"\n",
+               {"test.toml:2:8:", "'render.lens' expected one of \"map\", \"vertex\", \"undistort\"",
+                "got \"fisheye\""});
+  expect_error("[render]\nlens = 1\n", {"test.toml:2:8:", "'render.lens' expected one of", "got an integer"});
+  expect_error("[render]\nlens_canvas_scale = 0.5\n",
+               {"test.toml:2:21:", "'render.lens_canvas_scale' expected a number in [1, 4], got 0.5"});
+  expect_error("[render]\nlens_canvas_scale = 8\n", {"'render.lens_canvas_scale' expected a number in [1, 4], got 8.0"});
   expect_error("[source]\ntype = \"v4l2\"\n", {"test.toml:2:8:", "'source.type' expected one of \"replay\""});
   expect_error("[source]\npacing = \"slow\"\n", {"'source.pacing' expected one of \"timestamps\", \"fast\""});
   expect_error("[track]\nfamily = \"tag36h12\"\n",
@@ -331,7 +344,7 @@ TEST(Config, OverridesReplaceKeysBeforeValidation) {
   const Config c = parse_config(file, "o.toml",
                                 {"pipeline.queue_depth=3", "track.family = \"tag25h9\"", "source.pacing=fast",
                                  "render.objects.1.scale=0.25", "render.objects.0.position_m=[1, 2, 3]",
-                                 "sinks.png.dir=out/run1", "render.ambient=[0.5, 0.5, 0.5]"});
+                                 "sinks.png.dir=out/run1", "render.ambient=[0.5, 0.5, 0.5]", "render.lens=vertex"});
   EXPECT_EQ(c.pipeline.queue_depth, 3);
   EXPECT_EQ(c.track.family, "tag25h9");
   EXPECT_EQ(c.source.pacing, "fast");  // a bare word is a string
@@ -341,6 +354,7 @@ TEST(Config, OverridesReplaceKeysBeforeValidation) {
   EXPECT_EQ(c.render.objects[1].scale, 0.25);
   EXPECT_EQ(c.sinks.png.dir, "out/run1");
   EXPECT_EQ(c.render.ambient, (Vec3{0.5, 0.5, 0.5}));
+  EXPECT_EQ(c.render.lens, "vertex");
   // Later overrides win; an inline table replaces the whole table.
   const Config d = parse_config("[source]\npath = \"a\"\nloop = true\n", "o.toml",
                                 {"pipeline.max_frames=5", "pipeline.max_frames=6", "source={path=\"b\"}"});
@@ -372,6 +386,9 @@ TEST(Config, BadOverridesAreErrorsNamingTheOverride) {
                {"track.bundle.0.size_m=0.2"});
   expect_error("[source]\npath = \"x\"\n", {"override 'source.path.deeper=1'", "'source.path' is a string, not a table"},
                {"source.path.deeper=1"});
+  expect_error("", {"override 'render.lens=warp'", "'render.lens' expected one of \"map\", \"vertex\", \"undistort\"",
+                    "got \"warp\""},
+               {"render.lens=warp"});
 }
 
 }  // namespace

@@ -12,6 +12,8 @@
 #include <set>
 
 #include "core/image/pixel_convert.h"
+#include "render/lens_undistortion.h"
+#include "render/lens_warp_map.h"
 #include "render/render_errors.h"
 #include "tests/scene/gltf_test_files.h"
 #include "render_test_support.h"
@@ -139,20 +141,65 @@ TEST(RenderStages, PinholeCoverageWithMsaa) {
   EXPECT_GT(counts.outside, 40000);
 }
 
-TEST(RenderStages, OpenCv8CoverageFollowsTheLens) {
-  harness().configure(cube_config(4));
+CoverageCounts opencv8_coverage(const std::string& lens, double band) {
+  Config config = cube_config(4);
+  config.render.lens = lens;
+  harness().configure(config);
   const Frame background = varied_background(kWidth, kHeight);
   // Off to the side of the image, where the lens bends the cube's edges most.
   const SE3 pose = look_at({0.12, -0.30, 0.26}, {-0.09, 0.02, 0.04});
   FrameContext ctx = make_context(background, opencv8_camera(), pose);
   harness().process(ctx);
-  ASSERT_TRUE(ctx.virtual_layer_drawn);
+  EXPECT_TRUE(ctx.virtual_layer_drawn);
+  if (!ctx.virtual_layer_drawn) return {};
+  EXPECT_EQ(ctx.output_camera_model, ctx.camera_model);
+  return check_coverage(ctx, background, pose, band, expected_unlit_color());
+}
+
+TEST(RenderStages, OpenCv8CoverageFollowsTheLensPerVertex) {
   // 1 px covers multisampled edges and the chords between the mesh's vertices (the lens is
   // applied per vertex; the cube's 8x8 grid per face keeps chord sag well under a pixel).
-  const CoverageCounts counts = check_coverage(ctx, background, pose, 1.0, expected_unlit_color());
+  const CoverageCounts counts = opencv8_coverage("vertex", 1.0);
   EXPECT_EQ(counts.wrong, 0);
   EXPECT_GT(counts.inside, 1500);
   EXPECT_GT(counts.outside, 40000);
+}
+
+TEST(RenderStages, OpenCv8CoverageFollowsTheLensThroughTheWarpMap) {
+  // The warp samples the multisampled canvas bilinearly: what reaches a pixel comes from canvas
+  // points within 1 texel (the taps) plus half a texel (the samples inside a texel) along each
+  // axis, so within 1.5 sqrt(2) texels; in image pixels that is 1.5 sqrt(2) over the smallest
+  // number of canvas texels per image pixel.
+  const LensWarpMap map(*opencv8_camera(), cube_config(4).render.lens_canvas_scale);
+  double texels_per_pixel = INFINITY;
+  for (int y = 0; y + 1 < kHeight; ++y)
+    for (int x = 0; x + 1 < kWidth; ++x) {
+      const Vec2 c = map.at(x, y), right = map.at(x + 1, y), below = map.at(x, y + 1);
+      texels_per_pixel = std::min({texels_per_pixel, std::hypot(right[0] - c[0], right[1] - c[1]),
+                                   std::hypot(below[0] - c[0], below[1] - c[1])});
+    }
+  const double band = 1.5 * std::sqrt(2.0) / texels_per_pixel;
+  std::cout << "smallest canvas texels per image pixel " << texels_per_pixel << ": band " << band << " px\n";
+  const CoverageCounts counts = opencv8_coverage("map", band);
+  EXPECT_EQ(counts.wrong, 0);
+  EXPECT_GT(counts.inside, 1500);
+  EXPECT_GT(counts.outside, 40000);
+}
+
+TEST(RenderStages, PinholeLensDrawsTheSameInMapAndVertexModes) {
+  // A pinhole lens needs no warp: "map" draws straight into the image, byte for byte as "vertex".
+  const Frame background = varied_background(kWidth, kHeight);
+  std::vector<uint8_t> outputs[2];
+  for (int i = 0; i < 2; ++i) {
+    Config config = cube_config(4);
+    config.render.lens = i == 0 ? "map" : "vertex";
+    harness().configure(config);
+    FrameContext ctx = make_context(background, pinhole_camera(), oblique_pose());
+    harness().process(ctx);
+    ASSERT_TRUE(ctx.virtual_layer_drawn);
+    outputs[i] = ctx.output.data;
+  }
+  EXPECT_TRUE(outputs[0] == outputs[1]);
 }
 
 TEST(RenderStages, LambertShadingPerFace) {
@@ -308,13 +355,28 @@ TEST(RenderStages, DisabledRenderingIsAPassThrough) {
 }
 
 TEST(RenderStages, UnsupportedLensModelIsRecordedAndPassesThrough) {
-  harness().configure(cube_config(4));
+  Config config = cube_config(4);
+  config.render.lens = "vertex";  // the vertex shader knows PINHOLE and OPENCVn only
+  harness().configure(config);
   const Frame camera_frame = yuyv_camera_frame();
   auto stereographic =
       std::make_shared<const CameraModel>("LENSMODEL_STEREOGRAPHIC", std::vector<double>{300, 300, 159.5, 119.5}, kWidth, kHeight);
   FrameContext ctx = make_context(camera_frame, stereographic, oblique_pose());
   harness().process(ctx);
-  expect_pass_through(ctx, camera_frame, "error: lens model LENSMODEL_STEREOGRAPHIC is not yet supported by the renderer");
+  expect_pass_through(ctx, camera_frame,
+                      "error: lens model LENSMODEL_STEREOGRAPHIC is not supported by render.lens = \"vertex\"");
+  EXPECT_EQ(ctx.output_camera_model, stereographic);
+}
+
+TEST(RenderStages, LensTooWideForTheCanvasIsRecordedAndPassesThrough) {
+  harness().configure(cube_config(4));  // render.lens = "map"
+  const Frame camera_frame = yuyv_camera_frame();
+  // Stereographic with f = 80 px: the corners of 320x240 are 2 atan(200 / 160) = 103 degrees off axis.
+  auto fisheye =
+      std::make_shared<const CameraModel>("LENSMODEL_STEREOGRAPHIC", std::vector<double>{80, 80, 159.5, 119.5}, kWidth, kHeight);
+  FrameContext ctx = make_context(camera_frame, fisheye, oblique_pose());
+  harness().process(ctx);
+  expect_pass_through(ctx, camera_frame, "error: lens model LENSMODEL_STEREOGRAPHIC sees rays 10");
 }
 
 TEST(RenderStages, CameraModelOfAnotherSizeIsRecordedAndPassesThrough) {
@@ -420,6 +482,52 @@ TEST(RenderStages, UnknownBuiltinMeshFailsConfigureNamingTheKey) {
     EXPECT_NE(std::string(e.what()).find("render.objects[0].mesh"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("builtin:teapot"), std::string::npos) << e.what();
   }
+}
+
+TEST(RenderStages, UndistortModeUndistortsEveryFrameAndSaysSo) {
+  Config config = cube_config(4);
+  config.render.lens = "undistort";
+  harness().configure(config);
+  const Frame camera_frame = yuyv_camera_frame();
+  Frame rgb = Frame::allocate(PixelFormat::RGB24, kWidth, kHeight);
+  to_rgb24(camera_frame, rgb.data);
+  Frame undistorted;
+  const LensUndistortion undistortion(*opencv8_camera());
+  undistortion.apply(rgb, undistorted);
+  const CameraModel& core = *undistortion.pinhole_core();
+  // Nothing drawn (pose lost): the undistorted frame, made on the CPU, with the core as its model.
+  FrameContext lost = make_context(camera_frame, opencv8_camera(), oblique_pose(), TrackState::Lost);
+  harness().process(lost);
+  EXPECT_FALSE(lost.virtual_layer_drawn);
+  EXPECT_TRUE(lost.output.data == undistorted.data);
+  ASSERT_NE(lost.output_camera_model, nullptr);
+  EXPECT_EQ(lost.output_camera_model->lensmodel(), "LENSMODEL_PINHOLE");
+  EXPECT_EQ(lost.output_camera_model->intrinsics(), core.intrinsics());
+  // Drawn: the cube where the pinhole core sees it, over the undistorted frame.
+  const SE3 pose = oblique_pose();
+  FrameContext drawn = make_context(camera_frame, opencv8_camera(), pose);
+  harness().process(drawn);
+  ASSERT_TRUE(drawn.virtual_layer_drawn);
+  EXPECT_EQ(drawn.output_camera_model->lensmodel(), "LENSMODEL_PINHOLE");
+  const std::vector<PixelTruth> truth = classify_image(core, pose, kCube, 1.0);
+  const std::array<int, 3> expected = expected_unlit_color();
+  int inside = 0, wrong = 0;
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x) {
+      const PixelClass cls = truth[size_t(y) * kWidth + x].cls;
+      const uint8_t* out = pixel_at(drawn.output, x, y);
+      const uint8_t* in = pixel_at(undistorted, x, y);
+      bool right = true;
+      if (cls == PixelClass::Inside) {
+        ++inside;
+        for (size_t c = 0; c < 3; ++c) right = right && std::abs(out[c] - expected[c]) <= 1;
+      } else if (cls == PixelClass::Outside) {
+        for (size_t c = 0; c < 3; ++c) right = right && out[c] == in[c];
+      }
+      if (!right && ++wrong <= 5) ADD_FAILURE() << "pixel (" << x << ", " << y << ")";
+    }
+  EXPECT_EQ(wrong, 0);
+  EXPECT_GT(inside, 2000);
 }
 
 }  // namespace
