@@ -44,6 +44,12 @@ std::unique_ptr<PipelineRunner> assemble_pipeline(const Config& config) {
   // refused before streaming starts. "undistort" changes the output even without objects.
   const LensMode lens = parse_lens_mode(config.render.lens);
   const bool renders = config.render.enabled && !config.render.objects.empty();
+  // Tracking and rendering project through the camera's model: without one nothing would land
+  // where it belongs. (A model of another image size is refused by the source that loads it.)
+  if ((renders || config.track.enabled) && !source->camera_model())
+    throw ConfigError(fmt::format(
+        "{}: no camera model: calibrate the camera (arpipe calib, docs/CALIBRATION.md) and set source.camera_model",
+        source->describe()));
   if ((renders || lens == LensMode::Undistort) && source->camera_model()) {
     try {
       check_lens_for_mode(*source->camera_model(), lens);
