@@ -140,7 +140,11 @@ CalibrationReport make_report(const CalibrationResult& result, int images_total,
   const double w = r.width - 1.0;
   const double h = r.height - 1.0;
   r.uncertainty = projection_uncertainty(result, {{w / 2, h / 2}, {0, 0}, {w, 0}, {0, h}, {w, h}}, 0.0);
-  if (!r.uncertainty.empty() && r.rms_per_coordinate_px > 0) r.observed_pixel_stdev = r.rms_per_coordinate_px;
+  std::vector<Vec2> grid;
+  for (int j = 0; j < r.uncertainty_grid_rows; ++j)
+    for (int i = 0; i < r.uncertainty_grid_cols; ++i)
+      grid.push_back({w * i / (r.uncertainty_grid_cols - 1), h * j / (r.uncertainty_grid_rows - 1)});
+  r.uncertainty_grid = projection_uncertainty(result, grid, 0.0);
   r.stages = result.stages;
   r.solve_seconds = result.seconds;
   r.advice = advice_for(r);
@@ -218,6 +222,14 @@ std::string report_json(const CalibrationReport& r) {
     uncertainty.push_back({{"pixel", {u.pixel[0], u.pixel[1]}},
                            {"worst_direction_stdev_px", u.worst_direction_stdev_px},
                            {"rms_stdev_px", u.rms_stdev_px}});
+  auto& grid = j["projection_uncertainty_grid"] = {{"cols", r.uncertainty_grid_cols},
+                                                   {"rows", r.uncertainty_grid_rows},
+                                                   {"pixels", nlohmann::ordered_json::array()},
+                                                   {"worst_direction_stdev_px", nlohmann::ordered_json::array()}};
+  for (const PixelUncertainty& u : r.uncertainty_grid) {
+    grid["pixels"].push_back({u.pixel[0], u.pixel[1]});
+    grid["worst_direction_stdev_px"].push_back(u.worst_direction_stdev_px);
+  }
   auto& stages = j["stages"] = nlohmann::ordered_json::array();
   for (const SolveStage& s : r.stages)
     stages.push_back({{"name", s.name}, {"rms_per_coordinate_px", s.rms_per_coordinate_px}, {"outliers", s.outliers},

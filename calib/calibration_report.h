@@ -47,8 +47,12 @@ struct CalibrationReport {
   std::vector<ImageResidual> per_image;       // in view order
   std::vector<int> worst_images;              // indices into per_image, worst RMS first (up to 5)
   CoverageGrid coverage;
-  double observed_pixel_stdev = 0;            // what the uncertainty assumed
   std::vector<PixelUncertainty> uncertainty;  // centre, then the four corners; at infinity
+  // The same on a grid over the whole image (9 x 7 points, corners and edges included, row-major):
+  // where the model is known well and where it is extrapolated.
+  int uncertainty_grid_cols = 9;
+  int uncertainty_grid_rows = 7;
+  std::vector<PixelUncertainty> uncertainty_grid;
   std::vector<SolveStage> stages;
   double solve_seconds = 0;
   std::vector<std::string> advice;            // things to fix before trusting the model
