@@ -10,10 +10,15 @@
 #include "calib/board_observation.h"
 #include "calib/calibration_board.h"
 
+namespace arpipe {
+class CameraModel;
+}
+
 namespace arpipe::calib {
 
 class BoardDetector {
  public:
+  // Throws BoardError when the board's tag family is not one libapriltag knows.
   explicit BoardDetector(const CalibrationBoard& board);
   ~BoardDetector();
   BoardDetector(const BoardDetector&) = delete;
@@ -22,13 +27,28 @@ class BoardDetector {
   // The board in this image, or nullopt when it is not found (too few points, wrong geometry).
   // grey: width x height bytes, rows `stride` apart. Never throws. Safe to call from one thread at
   // a time per detector (make one detector per thread).
+  // Chessboards: mrgingham finds a square board, findChessboardCornersSB a non-square one or a
+  // square one mrgingham missed (BoardObservation::detector says which); cornerSubPix refines the
+  // corners. The points come in one canonical order: the board seen from its printed side (the
+  // board frame right-handed with z away from the camera), rows running as nearly left to right
+  // in the image as the board's symmetry allows. A point that was not seen has weight -1 and
+  // pixel (-1, -1).
   std::optional<BoardObservation> detect(const unsigned char* grey, int width, int height, size_t stride,
                                          const std::string& image_name) const;
+  // The same with the lens known approximately, from a first solve. It matters for AprilTag grids
+  // only: a tag's centre is then found where the lens really puts it (without the lens it is off
+  // by the lens's bend over the tag: 0.1-0.4 px for a wide lens). nullopt when the lens's image
+  // size is not the image's.
+  std::optional<BoardObservation> detect(const unsigned char* grey, int width, int height, size_t stride,
+                                         const std::string& image_name, const CameraModel& lens) const;
 
   // Which method detect() uses for this board: "mrgingham", "findChessboardCornersSB", "apriltag".
   const std::string& method() const;
 
  private:
+  std::optional<BoardObservation> find(const unsigned char* grey, int width, int height, size_t stride,
+                                       const std::string& image_name, const CameraModel* lens) const;
+
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

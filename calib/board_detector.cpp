@@ -1,0 +1,393 @@
+// Board detection: chessboards by mrgingham (square boards) or OpenCV, refined by cornerSubPix and
+// put into one canonical point order; AprilTag grids by tag id, each tag's centre from its corners.
+#include "calib/board_detector.h"
+
+#include <fmt/format.h>
+#include <mrgingham/mrgingham.hh>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+#include <set>
+#include <vector>
+
+#include "core/config/config.h"
+#include "core/geometry/camera_model.h"
+#include "core/track/tag_corner_refiner.h"
+#include "core/track/tag_detector.h"
+
+namespace arpipe::calib {
+
+namespace {
+
+// Chessboards: mrgingham on square boards, findChessboardCornersSB on the others and where
+// mrgingham finds nothing; cornerSubPix then refines the corners on the image as it came. Measured
+// on the simulator's calib-board capture (60 frames, noise on; the table is in
+// tests/calib/board_chessboard_test.cpp): SB's own corners are off by up to 0.5-1.5 px where a
+// corner is strongly sheared (RMS 0.08-0.18 px), while cornerSubPix on them gives RMS 0.093 px,
+// max 0.39 px, unbiased. So SB only has to find the board: with no flag or EXHAUSTIVE it finds all
+// 60; NORMALIZE_IMAGE and ACCURACY each lose the most oblique view (squares 7 px across in an image
+// corner), and ACCURACY is 3-4x slower. EXHAUSTIVE is OpenCV's "improve detection rate" search, at
+// no measured cost where the board is found. (The classic findChessboardCorners on a 2x upsampled
+// image finds every board too, but takes 1-4.6 s to give up on a view whose board is cut off.)
+constexpr int kSbFlags = cv::CALIB_CB_EXHAUSTIVE;
+
+// mrgingham's own CLI (mrgingham-from-image.cc) stretches the image to 0..255, applies CLAHE with
+// clip limit 8 and a 3x3 box blur; the library does none of it. Measured on 10 rendered views of
+// mrgingham's own board (chessboard.10x10.pdf: wider outer squares), 16 samples/px: without it
+// mrgingham found 8 and its corners had RMS 0.27 px; with it, all 10 at 0.136 px; refined by
+// cornerSubPix on the original image, 0.051 px (max 0.15 px), as SB + cornerSubPix there. On a
+// board whose outer squares are not wider it misses more (2 of 3 rendered views found), hence
+// the fallback to SB.
+constexpr double kClaheClipLimit = 8.0;
+constexpr int kBlurRadius = 1;
+
+// cornerSubPix's half window, per corner: this share of the distance to its nearest neighbour,
+// within [2, 10] px. Measured on the calib-board capture: 0.25, 0.3, 0.4, 0.5 gave RMS 0.107,
+// 0.101, 0.094, 0.090 px; a larger window averages more of the edges until it takes in the next
+// junction (a fixed 5 px window on 7 px squares: errors of 4 px), so 0.4 keeps a margin. A corner
+// that the refinement moves farther than kMaxRefineShare of that distance has slid towards
+// another junction and keeps its first place.
+constexpr double kRefineWindowShare = 0.4;
+constexpr int kMinRefineWindow = 2;
+constexpr int kMaxRefineWindow = 10;
+constexpr double kMaxRefineShare = 0.3;
+
+// An observation needs at least this share of the board's points, spread over two rows and two
+// columns. Why: the solve seeds each board pose by PnP from the points seen (two rows and columns
+// make them non-collinear), and a view with few points fixes its own six pose parameters from
+// little more than six numbers, so it adds little about the lens while any wrong tag id it carries
+// weighs as much as in a full view. 60% still keeps the partial views at the image's edges and
+// corners, where the lens distortion is largest and observations are scarcest.
+constexpr double kMinSeenFraction = 0.6;
+
+// libapriltag's decision margin below which a detection is not trusted (the tracker's default).
+constexpr double kMinDecisionMargin = 20.0;
+// Quads found at full resolution: calibration tags are small. Measured on a 5 x 6 grid of 30 mm
+// tags 0.75-1 m away (16-20 px across) in 640 x 480 frames: decimation 1 found all 29 tags in each
+// of 3 views, 1.5 lost 2 in one, 2 found 5-21, 3 none; decimation 1 costs 20-26 ms per frame.
+constexpr double kAprilTagQuadDecimate = 1.0;
+
+// Pixel of a point that was not seen (weight -1): outside every image, never a plausible corner.
+constexpr Vec2 kUnseen{-1.0, -1.0};
+
+// A rows x cols grid of detected points in row-major order (index r*cols + c).
+struct Grid {
+  int rows = 0;
+  int cols = 0;
+  std::vector<Vec2> px;
+  std::vector<double> weights;
+
+  const Vec2& at(int r, int c) const { return px[static_cast<size_t>(r * cols + c)]; }
+
+  // Mean image direction from one column to the next (along a row) and from one row to the next.
+  Vec2 row_direction() const {
+    Vec2 d{0, 0};
+    for (int r = 0; r < rows; ++r)
+      for (int c = 0; c + 1 < cols; ++c) d = {d[0] + at(r, c + 1)[0] - at(r, c)[0], d[1] + at(r, c + 1)[1] - at(r, c)[1]};
+    return d;
+  }
+  Vec2 column_direction() const {
+    Vec2 d{0, 0};
+    for (int r = 0; r + 1 < rows; ++r)
+      for (int c = 0; c < cols; ++c) d = {d[0] + at(r + 1, c)[0] - at(r, c)[0], d[1] + at(r + 1, c)[1] - at(r, c)[1]};
+    return d;
+  }
+
+  // new(r, c) = old(map(r, c)); the shape stays rows x cols (square grids for the 90-degree turns).
+  template <typename Map>
+  Grid remapped(Map map) const {
+    Grid out = *this;
+    for (int r = 0; r < rows; ++r)
+      for (int c = 0; c < cols; ++c) {
+        const auto [r0, c0] = map(r, c);
+        out.px[static_cast<size_t>(r * cols + c)] = px[static_cast<size_t>(r0 * cols + c0)];
+        out.weights[static_cast<size_t>(r * cols + c)] = weights[static_cast<size_t>(r0 * cols + c0)];
+      }
+    return out;
+  }
+};
+
+// The canonical order of a chessboard's corners, which no detector guarantees on its own:
+// 1. The board's frame (x along a row, y down the rows, z = x cross y) has its printed face
+//    towards the camera, z pointing away from it, so in the image x-then-y turns clockwise
+//    (image y is down). A mirrored order fits a flat grid too, but only as the board seen from
+//    behind: the solve's board warp (a bulge along the board's z, shared by all views) would flip
+//    sign in that view, and PnP seeds such a view with the camera behind the board.
+// 2. Of the orders the grid's symmetry still allows (a 180-degree turn; on a square board also the
+//    90-degree turns), the one whose rows run most nearly left to right in the image, so point 0 is
+//    at the top left as in mrgingham's output: views of one board held the same way agree.
+Grid canonical_order(const Grid& grid) {
+  Grid g = grid;
+  const Vec2 x = g.row_direction();
+  const Vec2 y = g.column_direction();
+  if (x[0] * y[1] - x[1] * y[0] < 0) {
+    const int cols = g.cols;
+    g = g.remapped([cols](int r, int c) { return std::pair{r, cols - 1 - c}; });
+  }
+  std::vector<Grid> candidates{g, g.remapped([&g](int r, int c) { return std::pair{g.rows - 1 - r, g.cols - 1 - c}; })};
+  if (g.rows == g.cols) {
+    const int n = g.rows;
+    candidates.push_back(g.remapped([n](int r, int c) { return std::pair{c, n - 1 - r}; }));
+    candidates.push_back(g.remapped([n](int r, int c) { return std::pair{n - 1 - c, r}; }));
+  }
+  const auto leftness = [](const Grid& candidate) {
+    const Vec2 d = candidate.row_direction();
+    const double length = norm(d);
+    return length > 0 ? d[0] / length : -1.0;
+  };
+  return *std::max_element(candidates.begin(), candidates.end(),
+                           [&](const Grid& a, const Grid& b) { return leftness(a) < leftness(b); });
+}
+
+// Sub-pixel corners by cornerSubPix (gradients orthogonal to the corner-to-pixel vector over a
+// window), on the image as it came.
+void refine_corners(const cv::Mat& image, Grid& grid) {
+  const cv::TermCriteria stop(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50, 0.001);
+  const Grid found = grid;
+  for (int r = 0; r < grid.rows; ++r)
+    for (int c = 0; c < grid.cols; ++c) {
+      double spacing = std::numeric_limits<double>::infinity();
+      const Vec2& p = found.at(r, c);
+      for (const auto& [dr, dc] : {std::pair{-1, 0}, {1, 0}, {0, -1}, {0, 1}}) {
+        if (r + dr < 0 || r + dr >= grid.rows || c + dc < 0 || c + dc >= grid.cols) continue;
+        const Vec2& q = found.at(r + dr, c + dc);
+        spacing = std::min(spacing, std::hypot(q[0] - p[0], q[1] - p[1]));
+      }
+      const int window = std::clamp(static_cast<int>(kRefineWindowShare * spacing), kMinRefineWindow, kMaxRefineWindow);
+      std::vector<cv::Point2f> corner{cv::Point2f(static_cast<float>(p[0]), static_cast<float>(p[1]))};
+      cv::cornerSubPix(image, corner, cv::Size(window, window), cv::Size(-1, -1), stop);
+      const Vec2 refined{corner[0].x, corner[0].y};
+      if (std::hypot(refined[0] - p[0], refined[1] - p[1]) <= kMaxRefineShare * spacing)
+        grid.px[static_cast<size_t>(r * grid.cols + c)] = refined;
+    }
+}
+
+bool finite_inside(const Vec2& p, int width, int height) {
+  return std::isfinite(p[0]) && std::isfinite(p[1]) && p[0] >= -0.5 && p[1] >= -0.5 && p[0] <= width - 0.5 &&
+         p[1] <= height - 0.5;
+}
+
+// Whether a tag's white ring (one code cell around its black square) lies inside the image. A tag
+// cut by the image's edge can still yield a quad, with a corner on the edge (AprilRobotics/apriltag
+// #375), and its centre would then be wrong.
+bool white_ring_inside(const std::array<Vec2, 4>& q, int border_cells, int width, int height) {
+  double perimeter = 0;
+  for (size_t k = 0; k < 4; ++k) perimeter += std::hypot(q[(k + 1) % 4][0] - q[k][0], q[(k + 1) % 4][1] - q[k][1]);
+  const double cell = perimeter / 4 / border_cells;
+  for (const Vec2& p : q)
+    if (!(p[0] >= cell && p[1] >= cell && p[0] <= width - 1 - cell && p[1] <= height - 1 - cell)) return false;
+  return true;
+}
+
+// Where the diagonals of a quad cross: the image of the tag's centre under any homography, so
+// exact for a pinhole view of the flat tag (a lens's distortion bends it by a second-order amount).
+std::optional<Vec2> diagonal_intersection(const std::array<Vec2, 4>& q) {
+  const Vec2 d0{q[2][0] - q[0][0], q[2][1] - q[0][1]};
+  const Vec2 d1{q[3][0] - q[1][0], q[3][1] - q[1][1]};
+  const double det = d0[0] * d1[1] - d0[1] * d1[0];
+  if (std::abs(det) < 1e-9 * (norm(d0) * norm(d1) + 1e-300)) return std::nullopt;
+  const Vec2 w{q[1][0] - q[0][0], q[1][1] - q[0][1]};
+  const double s = (w[0] * d1[1] - w[1] * d1[0]) / det;
+  // A convex quad's diagonals cross inside both of them.
+  const double t = (w[0] * d0[1] - w[1] * d0[0]) / det;
+  if (!(s > 0 && s < 1 && t > 0 && t < 1)) return std::nullopt;
+  return Vec2{q[0][0] + s * d0[0], q[0][1] + s * d0[1]};
+}
+
+// The image of a tag's centre. Where the diagonals of the tag's quad cross is the centre's image
+// under any homography, so exact for a pinhole view; through a real lens the tag's image is bent
+// and that point is off by the bend's second-order part: measured 0.10 px RMS on a full view and
+// 0.39 px near the image's edges for the calib scene's wide lens, with exact corners. Given the lens
+// (from a first solve), the diagonals are crossed in undistorted coordinates instead, where they
+// are straight: 0.0003 px with exact corners.
+std::optional<Vec2> tag_centre(const std::array<Vec2, 4>& corners, const CameraModel* lens) {
+  if (lens == nullptr) return diagonal_intersection(corners);
+  std::array<Vec2, 4> normalised;
+  for (size_t k = 0; k < 4; ++k) {
+    const auto n = lens->normalize(corners[k]);
+    if (!n) return std::nullopt;
+    normalised[k] = *n;
+  }
+  const auto centre = diagonal_intersection(normalised);
+  if (!centre) return std::nullopt;
+  return lens->project(Vec3{(*centre)[0], (*centre)[1], 1.0});
+}
+
+}  // namespace
+
+struct BoardDetector::Impl {
+  CalibrationBoard board;
+  std::string method;
+  // AprilTag grids only.
+  std::unique_ptr<TagDetector> tags;
+  TagCornerRefiner refiner{PixelFormat::GREY};
+
+  std::optional<BoardObservation> detect_chessboard(const cv::Mat& image) const;
+  std::optional<BoardObservation> detect_mrgingham(const cv::Mat& image) const;
+  std::optional<BoardObservation> detect_sb(const cv::Mat& image) const;
+  std::optional<BoardObservation> detect_apriltags(const cv::Mat& image, const CameraModel* lens) const;
+  // Refines the corners and puts them in the canonical order.
+  std::optional<BoardObservation> observation(Grid grid, const cv::Mat& image, const std::string& detector) const;
+};
+
+std::optional<BoardObservation> BoardDetector::Impl::observation(Grid grid, const cv::Mat& image,
+                                                                 const std::string& detector) const {
+  refine_corners(image, grid);
+  grid = canonical_order(grid);
+  BoardObservation out;
+  out.detector = detector;
+  out.pixels = std::move(grid.px);
+  out.weights = std::move(grid.weights);
+  return out;
+}
+
+std::optional<BoardObservation> BoardDetector::Impl::detect_mrgingham(const cv::Mat& image) const {
+  cv::Mat stretched, equalised, prepared;
+  cv::normalize(image, stretched, 0, 255, cv::NORM_MINMAX);
+  cv::Ptr<cv::CLAHE> clahe = cv::createCLAHE();
+  clahe->setClipLimit(kClaheClipLimit);
+  clahe->apply(stretched, equalised);
+  cv::blur(equalised, prepared, cv::Size(1 + 2 * kBlurRadius, 1 + 2 * kBlurRadius));
+
+  std::vector<mrgingham::PointDouble> points;
+  signed char* levels = nullptr;  // realloc()ed by mrgingham; left null when the board was found at level 0
+  const int found = mrgingham::find_chessboard_from_image_array(points, &levels, board.rows, prepared);
+  const size_t n = static_cast<size_t>(board.point_count());
+  std::optional<BoardObservation> out;
+  if (found >= 0 && points.size() == n) {
+    Grid grid{board.rows, board.cols, {}, {}};
+    for (size_t i = 0; i < n; ++i) {
+      grid.px.push_back({points[i].x, points[i].y});
+      const int level = levels != nullptr ? levels[i] : found;
+      grid.weights.push_back(std::ldexp(1.0, -std::max(0, level)));
+    }
+    out = observation(std::move(grid), image, "mrgingham");
+  }
+  std::free(levels);
+  return out;
+}
+
+std::optional<BoardObservation> BoardDetector::Impl::detect_sb(const cv::Mat& image) const {
+  std::vector<cv::Point2f> corners;
+  if (!cv::findChessboardCornersSB(image, cv::Size(board.cols, board.rows), corners, kSbFlags)) return std::nullopt;
+  if (corners.size() != static_cast<size_t>(board.point_count())) return std::nullopt;
+  Grid grid{board.rows, board.cols, {}, {}};
+  for (const cv::Point2f& p : corners) {
+    grid.px.push_back({p.x, p.y});
+    grid.weights.push_back(1.0);
+  }
+  return observation(std::move(grid), image, "findChessboardCornersSB");
+}
+
+std::optional<BoardObservation> BoardDetector::Impl::detect_chessboard(const cv::Mat& image) const {
+  std::optional<BoardObservation> out;
+  if (board.rows == board.cols) out = detect_mrgingham(image);
+  if (!out) out = detect_sb(image);
+  return out;
+}
+
+std::optional<BoardObservation> BoardDetector::Impl::detect_apriltags(const cv::Mat& image,
+                                                                      const CameraModel* lens) const {
+  std::vector<TagObservation> found;
+  tags->detect(image.data, image.cols, image.rows, image.step, found);
+
+  // Without a lens, a stand-in pinhole camera: the refiner then fits straight edges in the
+  // distorted image, as libapriltag does.
+  const CameraModel pinhole = CameraModel::pinhole(image.cols, image.cols, (image.cols - 1) / 2.0,
+                                                   (image.rows - 1) / 2.0, image.cols, image.rows);
+  const CameraModel& camera = lens != nullptr ? *lens : pinhole;
+  const int count = board.point_count();
+  std::vector<int> hits(static_cast<size_t>(count), 0);
+  std::vector<Vec2> centres(static_cast<size_t>(count), kUnseen);
+  for (TagObservation& tag : found) {
+    const int index = tag.id - board.first_id;
+    if (index < 0 || index >= count || tag.decision_margin < kMinDecisionMargin) continue;
+    if (!white_ring_inside(tag.corners, tags->border_cells(), image.cols, image.rows)) continue;
+    // Refinement moves corners by a fraction of a pixel; when it cannot (a tiny tag), keep
+    // libapriltag's corners.
+    refiner.refine(image.data, image.cols, image.rows, image.step, camera, tags->border_cells(), tag.corners);
+    const auto centre = tag_centre(tag.corners, lens);
+    if (!centre || !finite_inside(*centre, image.cols, image.rows)) continue;
+    ++hits[static_cast<size_t>(index)];
+    centres[static_cast<size_t>(index)] = *centre;
+  }
+
+  BoardObservation out;
+  out.detector = method;
+  out.pixels.resize(static_cast<size_t>(count), kUnseen);
+  out.weights.resize(static_cast<size_t>(count), -1.0);
+  std::set<int> rows, cols;
+  for (int i = 0; i < count; ++i) {
+    // An id seen twice is a false detection somewhere; neither place can be trusted.
+    if (hits[static_cast<size_t>(i)] != 1) continue;
+    out.pixels[static_cast<size_t>(i)] = centres[static_cast<size_t>(i)];
+    out.weights[static_cast<size_t>(i)] = 1.0;
+    rows.insert(i / board.cols);
+    cols.insert(i % board.cols);
+  }
+  if (out.seen_count() < std::ceil(kMinSeenFraction * count) || rows.size() < 2 || cols.size() < 2)
+    return std::nullopt;
+  return out;
+}
+
+BoardDetector::BoardDetector(const CalibrationBoard& board) : impl_(std::make_unique<Impl>()) {
+  impl_->board = board;
+  if (board.kind == BoardKind::apriltag_grid) {
+    impl_->method = "apriltag";
+    Config config;
+    config.track.family = board.family;
+    config.track.quad_decimate = kAprilTagQuadDecimate;
+    config.track.threads = 1;
+    try {
+      impl_->tags = std::make_unique<TagDetector>(config);
+    } catch (const std::exception& e) {  // a board made in code with a family libapriltag lacks
+      throw BoardError(fmt::format("{}: family: cannot detect \"{}\" tags: {}", board.name, board.family, e.what()));
+    }
+  } else {
+    impl_->method = board.rows == board.cols ? "mrgingham" : "findChessboardCornersSB";
+  }
+}
+
+BoardDetector::~BoardDetector() = default;
+
+const std::string& BoardDetector::method() const { return impl_->method; }
+
+std::optional<BoardObservation> BoardDetector::detect(const unsigned char* grey, int width, int height, size_t stride,
+                                                      const std::string& image_name) const {
+  return find(grey, width, height, stride, image_name, nullptr);
+}
+
+std::optional<BoardObservation> BoardDetector::detect(const unsigned char* grey, int width, int height, size_t stride,
+                                                      const std::string& image_name, const CameraModel& lens) const {
+  return find(grey, width, height, stride, image_name, &lens);
+}
+
+std::optional<BoardObservation> BoardDetector::find(const unsigned char* grey, int width, int height, size_t stride,
+                                                    const std::string& image_name, const CameraModel* lens) const {
+  if (grey == nullptr || width < 8 || height < 8 || stride < static_cast<size_t>(width)) return std::nullopt;
+  // A lens made for another image size would put every point in the wrong place.
+  if (lens != nullptr && (lens->width() != width || lens->height() != height)) return std::nullopt;
+  try {
+    const cv::Mat image(height, width, CV_8UC1, const_cast<unsigned char*>(grey), stride);
+    std::optional<BoardObservation> out;
+    if (impl_->method == "apriltag")
+      out = impl_->detect_apriltags(image, lens);
+    else
+      out = impl_->detect_chessboard(image);
+    if (!out) return std::nullopt;
+    for (size_t i = 0; i < out->pixels.size(); ++i)
+      if (out->weights[i] > 0 && !finite_inside(out->pixels[i], width, height)) return std::nullopt;
+    out->image = image_name;
+    out->width = width;
+    out->height = height;
+    return out;
+  } catch (...) {  // OpenCV or allocation failure: this image simply has no board
+    return std::nullopt;
+  }
+}
+
+}  // namespace arpipe::calib
