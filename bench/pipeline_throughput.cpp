@@ -26,12 +26,13 @@ long resident_kib() {
   return -1;
 }
 
-Config bench_config(const std::string& capture, int64_t frames, bool with_object) {
+Config bench_config(const std::string& capture, int64_t frames, bool with_object, const std::string& lens = "map") {
   std::vector<std::string> overrides{
       fmt::format("source.path=\"{}\"", capture), "source.pacing=\"fast\"", "source.loop=true",
       fmt::format("pipeline.max_frames={}", frames), "sinks.png.enabled=false", "sinks.y4m.enabled=false",
       "sinks.results.enabled=false", "pipeline.log_level=\"warning\""};
   if (!with_object) overrides.push_back("render.objects=[]");
+  overrides.push_back(fmt::format("render.lens=\"{}\"", lens));
   return parse_config("", "(benchmark)", overrides);
 }
 
@@ -75,7 +76,9 @@ int main(int argc, char** argv) {
   fmt::print("| run | frames | frames/s | track ms | render ms | composite ms |\n|---|---:|---:|---:|---:|---:|\n");
   // Warm-up (shader JIT, page cache), then the measured runs.
   run(bench_config(capture, 30, true));
-  print_row("default scene (cube on tag)", run(bench_config(capture, frames, true)));
+  print_row("default scene (cube on tag), render.lens = map (default)", run(bench_config(capture, frames, true)));
+  print_row("default scene, render.lens = vertex", run(bench_config(capture, frames, true, "vertex")));
+  print_row("default scene, render.lens = undistort", run(bench_config(capture, frames, true, "undistort")));
   print_row("pass-through (no virtual object)", run(bench_config(capture, frames, false)));
 
   if (soak_seconds > 0) {
