@@ -33,10 +33,12 @@ class CalibrationImages {
   virtual GreyImage load(size_t index) const = 0;
 };
 
-// Files matching a shell glob (sorted by name), in any format OpenCV's imread reads.
+// Files matching a shell glob (sorted by name; directories skipped), in any format OpenCV's imread
+// reads, in the sensor's orientation (EXIF rotation ignored).
 // Throws CalibrationInputError when the glob matches nothing.
 std::unique_ptr<CalibrationImages> images_from_glob(const std::string& pattern);
-// Every frame of a format-v1 recording (any pixel format the recording reader decodes).
+// Every frame of a format-v1 recording (any pixel format the recording reader decodes). YUV
+// frames give their luma, stretched from limited range (16-235) to 0-255 as image files have it.
 // Throws CalibrationInputError naming the directory when it cannot be opened.
 std::unique_ptr<CalibrationImages> images_from_recording(const std::filesystem::path& dir);
 
