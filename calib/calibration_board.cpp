@@ -16,6 +16,7 @@
 #include <sstream>
 #include <tuple>
 
+#include "core/config/toml_stray_key.h"
 #include "core/config/toml_type_phrase.h"
 #include "core/track/tag_family.h"
 
@@ -59,19 +60,12 @@ class BoardReader {
   // The first key in file order that is not allowed for this kind: unknown, or one of the other kind.
   void allow(const std::vector<std::string_view>& allowed, const std::vector<std::string_view>& other_kind,
              std::string_view kind) const {
-    const toml::key* first = nullptr;
-    for (auto&& [k, value] : root_) {
-      if (std::find(allowed.begin(), allowed.end(), k.str()) != allowed.end()) continue;
-      if (first == nullptr || std::tie(k.source().begin.line, k.source().begin.column) <
-                                  std::tie(first->source().begin.line, first->source().begin.column))
-        first = &k;
-    }
-    if (first == nullptr) return;
-    const toml::source_region& at =
-        first->source().begin.line != 0 ? first->source() : root_.get(first->str())->source();
-    if (std::find(other_kind.begin(), other_kind.end(), first->str()) != other_kind.end())
-      fail(at, first->str(), fmt::format("not allowed with kind = \"{}\"; expected one of {}", kind, join(allowed)));
-    fail(at, first->str(), fmt::format("unknown key; expected one of {}", join(allowed)));
+    const auto stray = first_stray_key(root_, allowed);
+    if (!stray) return;
+    if (std::find(other_kind.begin(), other_kind.end(), stray->name) != other_kind.end())
+      fail(stray->where, stray->name,
+           fmt::format("not allowed with kind = \"{}\"; expected one of {}", kind, join(allowed)));
+    fail(stray->where, stray->name, fmt::format("unknown key; expected one of {}", join(allowed)));
   }
 
   const toml::node& required(std::string_view key, const std::string& expected) const {

@@ -11,19 +11,12 @@
 #include "core/image/pixel_convert.h"
 #include "core/log.h"
 #include "core/pipeline/monotonic_clock.h"
+#include "render/fullscreen_triangle.h"
 #include "render/gl_error.h"
 #include "render/render_errors.h"
 
 namespace arpipe {
 namespace {
-
-// One triangle over the whole viewport; the scissor rectangle limits it to the drawn region.
-constexpr std::string_view kVertexShader = R"glsl(#version 300 es
-void main() {
-  vec2 corner = vec2(float((gl_VertexID & 1) << 2), float((gl_VertexID & 2) << 1));
-  gl_Position = vec4(corner - 1.0, 0.0, 1.0);
-}
-)glsl";
 
 // Pixel for pixel: GL rows are image rows in both textures and in the output.
 constexpr std::string_view kFragmentShader = R"glsl(#version 300 es
@@ -73,7 +66,7 @@ void CompositeStage::configure(const Config& config) {
   const LensMode lens = parse_lens_mode(config.render.lens);
   session_->make_current();
   if (program_.id() == 0) {
-    program_ = GlProgram("compositing", kVertexShader, kFragmentShader);
+    program_ = GlProgram("compositing", kFullScreenTriangleVertexShader, kFragmentShader);
     empty_vertex_array_ = GlVertexArray::create();
     glUseProgram(program_.id());
     glUniform1i(program_.uniform("u_virtual_layer"), 0);

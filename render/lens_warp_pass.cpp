@@ -2,19 +2,12 @@
 // where a LensWarpMap points, giving the virtual layer as the real lens sees it.
 #include "render/lens_warp_pass.h"
 
+#include "render/fullscreen_triangle.h"
 #include "render/gl_error.h"
 #include "render/render_errors.h"
 
 namespace arpipe {
 namespace {
-
-// One triangle over the whole viewport; the scissor rectangle limits it to the drawn region.
-constexpr std::string_view kVertexShader = R"glsl(#version 300 es
-void main() {
-  vec2 corner = vec2(float((gl_VertexID & 1) << 2), float((gl_VertexID & 2) << 1));
-  gl_Position = vec4(corner - 1.0, 0.0, 1.0);
-}
-)glsl";
 
 // GL rows are image rows in the map, the canvas and the output (lens_projection.h). Canvas
 // coordinates put texel centres on integers (mrcal's convention); GL's are at +0.5. Premultiplied
@@ -57,7 +50,7 @@ void main() {
 
 LensWarpPass::LensWarpPass(GLenum output_format)
     : output_format_(output_format),
-      program_("lens warp", kVertexShader, kFragmentShader),
+      program_("lens warp", kFullScreenTriangleVertexShader, kFragmentShader),
       empty_vertex_array_(GlVertexArray::create()) {
   glUseProgram(program_.id());
   glUniform1i(program_.uniform("u_canvas"), 0);

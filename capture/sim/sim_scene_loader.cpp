@@ -19,6 +19,7 @@
 #include <set>
 #include <sstream>
 
+#include "core/config/toml_stray_key.h"
 #include "core/config/toml_type_phrase.h"
 #include "core/scene/asset_error.h"
 #include "core/scene/builtin_meshes.h"
@@ -110,17 +111,8 @@ class Section {
 
   // Throws on the first key (in file order) that is not in `allowed`.
   void allow(const std::vector<std::string_view>& allowed) const {
-    const toml::key* first = nullptr;
-    for (auto&& [k, value] : t_) {
-      if (std::find(allowed.begin(), allowed.end(), k.str()) != allowed.end()) continue;
-      if (first == nullptr || std::tie(k.source().begin.line, k.source().begin.column) <
-                                  std::tie(first->source().begin.line, first->source().begin.column))
-        first = &k;
-    }
-    if (first == nullptr) return;
-    const toml::source_region& region =
-        first->source().begin.line != 0 ? first->source() : t_.get(first->str())->source();
-    r_.fail(region, key(first->str()), fmt::format("unknown key; expected one of {}", join(allowed)));
+    const auto stray = first_stray_key(t_, allowed);
+    if (stray) r_.fail(stray->where, key(stray->name), fmt::format("unknown key; expected one of {}", join(allowed)));
   }
   // A key that makes no sense with the rest of the table.
   void forbid(std::string_view k, const std::string& why) const {
