@@ -73,6 +73,16 @@ class ChildProcess {
   }
 
   std::string stderr_text() const { return read_text(stderr_path_); }
+  // Polls stderr until it holds `text`: how long the daemon takes depends on the machine (a
+  // sanitizer build is several times slower), so tests wait for what they look for, not a fixed time.
+  bool wait_for_stderr(const std::string& text, std::chrono::seconds timeout = std::chrono::seconds(30)) const {
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    while (stderr_text().find(text) == std::string::npos) {
+      if (std::chrono::steady_clock::now() > deadline) return false;
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    return true;
+  }
   std::string stdout_text() const { return read_text(stdout_path_); }
 
  private:

@@ -159,7 +159,8 @@ TEST_F(DaemonInput, SigtermDrainsAndFlushes) {
                            {"--config", config.string(), "--set", "source.pacing=\"timestamps\"", "--set",
                             "source.loop=true"},
                            dir_ / "logs");
-  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  ASSERT_TRUE(child.wait_for_stderr("arpiped: info: running")) << child.stderr_text();
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));  // frames flowing
   child.signal(SIGTERM);
   const int status = child.wait(std::chrono::seconds(30));
   ASSERT_NE(status, -1) << "did not stop";
@@ -185,17 +186,15 @@ TEST_F(DaemonInput, SighupReloadRefusesBadConfigAndKeepsRunning) {
                            {"--config", config.string(), "--set", "source.pacing=\"timestamps\"", "--set",
                             "source.loop=true"},
                            dir_ / "logs");
-  std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+  ASSERT_TRUE(child.wait_for_stderr("arpiped: info: running")) << child.stderr_text();
   const std::string good = test::read_text(config);
   std::ofstream(config, std::ios::trunc) << good << "[track]\nno_such_key = 1\n";
   child.signal(SIGHUP);
-  std::this_thread::sleep_for(std::chrono::milliseconds(1000));
-  EXPECT_NE(child.stderr_text().find("reload refused"), std::string::npos) << child.stderr_text();
+  EXPECT_TRUE(child.wait_for_stderr("reload refused")) << child.stderr_text();
   EXPECT_NE(child.stderr_text().find("no_such_key"), std::string::npos) << child.stderr_text();
   std::ofstream(config, std::ios::trunc) << good << "[render]\nlight_direction = [0.0, 0.0, 1.0]\n";
   child.signal(SIGHUP);
-  std::this_thread::sleep_for(std::chrono::milliseconds(1000));
-  EXPECT_NE(child.stderr_text().find("reload accepted"), std::string::npos) << child.stderr_text();
+  EXPECT_TRUE(child.wait_for_stderr("reload accepted")) << child.stderr_text();
   child.signal(SIGTERM);
   const int status = child.wait(std::chrono::seconds(30));
   ASSERT_TRUE(status != -1 && WIFEXITED(status)) << child.stderr_text();
