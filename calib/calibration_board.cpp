@@ -17,6 +17,7 @@
 #include <tuple>
 
 #include "core/config/toml_stray_key.h"
+#include "core/config/text_file.h"
 #include "core/config/toml_type_phrase.h"
 #include "core/track/tag_family.h"
 
@@ -214,15 +215,10 @@ CalibrationBoard parse_board(const std::string& text, const std::string& source_
 }
 
 CalibrationBoard load_board(const std::filesystem::path& path) {
-  std::error_code ec;
-  if (fs::is_directory(path, ec))
-    throw BoardError(fmt::format("{}: cannot read board file: it is a directory", path.string()));
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw BoardError(fmt::format("{}: cannot read board file: {}", path.string(), std::strerror(errno)));
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw BoardError(fmt::format("{}: cannot read board file: {}", path.string(), std::strerror(errno)));
-  return parse_board(text.str(), path.string());
+  std::string why;
+  const auto text = read_text_file(path, why);
+  if (!text) throw BoardError(fmt::format("{}: cannot read board file: {}", path.string(), why));
+  return parse_board(*text, path.string());
 }
 
 }  // namespace arpipe::calib

@@ -20,6 +20,7 @@
 #include <sstream>
 
 #include "core/config/toml_stray_key.h"
+#include "core/config/text_file.h"
 #include "core/config/toml_type_phrase.h"
 #include "core/scene/asset_error.h"
 #include "core/scene/builtin_meshes.h"
@@ -752,15 +753,10 @@ SimScene parse_sim_scene(const std::string& text, const std::string& source_name
 }
 
 SimScene load_sim_scene(const std::filesystem::path& path) {
-  std::error_code ec;
-  if (fs::is_directory(path, ec))
-    throw SceneError(fmt::format("{}: cannot read scene file: it is a directory", path.string()));
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw SceneError(fmt::format("{}: cannot read scene file: {}", path.string(), std::strerror(errno)));
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw SceneError(fmt::format("{}: cannot read scene file: {}", path.string(), std::strerror(errno)));
-  SimScene scene = parse_sim_scene(text.str(), path.string(), path.parent_path());
+  std::string why;
+  const auto text = read_text_file(path, why);
+  if (!text) throw SceneError(fmt::format("{}: cannot read scene file: {}", path.string(), why));
+  SimScene scene = parse_sim_scene(*text, path.string(), path.parent_path());
   scene.source_file = path;
   return scene;
 }

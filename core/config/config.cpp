@@ -20,6 +20,7 @@
 #include <set>
 #include <sstream>
 
+#include "core/config/text_file.h"
 #include "core/config/toml_type_phrase.h"
 #include "core/track/tag_family.h"
 
@@ -495,15 +496,10 @@ Config parse_config(const std::string& text, const std::string& source_name, con
 }
 
 Config load_config(const std::filesystem::path& path, const std::vector<std::string>& overrides) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec))
-    throw ConfigError(fmt::format("{}: cannot read config: it is a directory", path.string()));
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw ConfigError(fmt::format("{}: cannot read config: {}", path.string(), std::strerror(errno)));
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw ConfigError(fmt::format("{}: cannot read config: {}", path.string(), std::strerror(errno)));
-  Config config = parse_config(text.str(), path.string(), overrides);
+  std::string why;
+  const auto text = read_text_file(path, why);
+  if (!text) throw ConfigError(fmt::format("{}: cannot read config: {}", path.string(), why));
+  Config config = parse_config(*text, path.string(), overrides);
   config.file = path;
   return config;
 }
