@@ -2,6 +2,8 @@
 // put into one canonical point order; AprilTag grids by tag id, each tag's centre from its corners.
 #include "calib/board_detector.h"
 
+#include "calib/chessboard_corner_fit.h"
+
 #include <fmt/format.h>
 #include <mrgingham/mrgingham.hh>
 
@@ -55,6 +57,12 @@ constexpr double kRefineWindowShare = 0.4;
 constexpr int kMinRefineWindow = 2;
 constexpr int kMaxRefineWindow = 10;
 constexpr double kMaxRefineShare = 0.3;
+
+// The model fit's window radius: this share of the distance to the nearest neighbour, within
+// [kMinFitRadius, kMaxFitRadius] px.
+constexpr double kFitRadiusShare = 0.45;
+constexpr double kMinFitRadius = 2.5;
+constexpr double kMaxFitRadius = 10;
 
 // An observation needs at least this share of the board's points, spread over two rows and two
 // columns. Why: the solve seeds each board pose by PnP from the points seen (two rows and columns
@@ -143,9 +151,13 @@ Grid canonical_order(const Grid& grid) {
                            [&](const Grid& a, const Grid& b) { return leftness(a) < leftness(b); });
 }
 
-// Sub-pixel corners by cornerSubPix (gradients orthogonal to the corner-to-pixel vector over a
-// window), on the image as it came.
-void refine_corners(const cv::Mat& image, Grid& grid) {
+// Sub-pixel corners: cornerSubPix (gradients orthogonal to the corner-to-pixel vector over a
+// window), on the image as it came, then optionally the X-junction model fit from there, with the
+// edges' directions from the neighbouring corners. A corner either step moves farther than
+// kMaxRefineShare of the distance to its nearest neighbour has slid towards another junction and
+// keeps its place from before that step.
+void refine_corners(const cv::Mat& image, CornerRefinement refinement, Grid& grid) {
+  if (refinement == CornerRefinement::none) return;
   const cv::TermCriteria stop(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50, 0.001);
   const Grid found = grid;
   for (int r = 0; r < grid.rows; ++r)
@@ -160,9 +172,19 @@ void refine_corners(const cv::Mat& image, Grid& grid) {
       const int window = std::clamp(static_cast<int>(kRefineWindowShare * spacing), kMinRefineWindow, kMaxRefineWindow);
       std::vector<cv::Point2f> corner{cv::Point2f(static_cast<float>(p[0]), static_cast<float>(p[1]))};
       cv::cornerSubPix(image, corner, cv::Size(window, window), cv::Size(-1, -1), stop);
-      const Vec2 refined{corner[0].x, corner[0].y};
-      if (std::hypot(refined[0] - p[0], refined[1] - p[1]) <= kMaxRefineShare * spacing)
-        grid.px[static_cast<size_t>(r * grid.cols + c)] = refined;
+      Vec2 refined{corner[0].x, corner[0].y};
+      if (std::hypot(refined[0] - p[0], refined[1] - p[1]) > kMaxRefineShare * spacing) refined = p;
+      if (refinement == CornerRefinement::model_fit) {
+        // The edges through the corner run towards the neighbours in its row and its column.
+        const Vec2 along_row = found.at(r, std::min(c + 1, grid.cols - 1)) - found.at(r, std::max(c - 1, 0));
+        const Vec2 along_column = found.at(std::min(r + 1, grid.rows - 1), c) - found.at(std::max(r - 1, 0), c);
+        CornerFitOptions options;
+        options.radius_px = std::clamp(kFitRadiusShare * spacing, kMinFitRadius, kMaxFitRadius);
+        if (const auto fitted = fit_chessboard_corner(image, refined, along_row, along_column, options);
+            fitted && std::hypot((*fitted)[0] - p[0], (*fitted)[1] - p[1]) <= kMaxRefineShare * spacing)
+          refined = *fitted;
+      }
+      grid.px[static_cast<size_t>(r * grid.cols + c)] = refined;
     }
 }
 
@@ -221,6 +243,7 @@ std::optional<Vec2> tag_centre(const std::array<Vec2, 4>& corners, const CameraM
 
 struct BoardDetector::Impl {
   CalibrationBoard board;
+  CornerRefinement refinement = CornerRefinement::model_fit;
   std::string method;
   // AprilTag grids only.
   std::unique_ptr<TagDetector> tags;
@@ -236,7 +259,7 @@ struct BoardDetector::Impl {
 
 std::optional<BoardObservation> BoardDetector::Impl::observation(Grid grid, const cv::Mat& image,
                                                                  const std::string& detector) const {
-  refine_corners(image, grid);
+  refine_corners(image, refinement, grid);
   grid = canonical_order(grid);
   BoardObservation out;
   out.detector = detector;
@@ -334,8 +357,9 @@ std::optional<BoardObservation> BoardDetector::Impl::detect_apriltags(const cv::
   return out;
 }
 
-BoardDetector::BoardDetector(const CalibrationBoard& board) : impl_(std::make_unique<Impl>()) {
+BoardDetector::BoardDetector(const CalibrationBoard& board, CornerRefinement refinement) : impl_(std::make_unique<Impl>()) {
   impl_->board = board;
+  impl_->refinement = refinement;
   if (board.kind == BoardKind::apriltag_grid) {
     impl_->method = "apriltag";
     Config config;

@@ -16,10 +16,17 @@ class CameraModel;
 
 namespace arpipe::calib {
 
+// How chessboard corners are refined after the board is found (AprilTag grids ignore it).
+enum class CornerRefinement {
+  none,           // the finder's own corners (mrgingham's or findChessboardCornersSB's)
+  corner_subpix,  // OpenCV's cornerSubPix
+  model_fit,      // cornerSubPix, then the X-junction model fit (calib/chessboard_corner_fit.h)
+};
+
 class BoardDetector {
  public:
   // Throws BoardError when the board's tag family is not one libapriltag knows.
-  explicit BoardDetector(const CalibrationBoard& board);
+  explicit BoardDetector(const CalibrationBoard& board, CornerRefinement refinement = CornerRefinement::model_fit);
   ~BoardDetector();
   BoardDetector(const BoardDetector&) = delete;
   BoardDetector& operator=(const BoardDetector&) = delete;

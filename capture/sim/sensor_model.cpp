@@ -1,6 +1,7 @@
 // The simulated image sensor: photons to electrons (Poisson shot noise), read noise, gains,
 // clipping, the response curve and 8-bit quantisation. All randomness comes from SampleRng.
 #include "capture/sim/sensor_model.h"
+#include "core/image/srgb.h"
 
 #include <algorithm>
 #include <charconv>
@@ -48,18 +49,6 @@ double poisson_by_inversion(double mean, SampleRng& rng) {
   return double(k);
 }
 
-// IEC 61966-2-1 sRGB transfer function and its inverse.
-// Full scale maps to exactly 1 (1.055 - 0.055 is 1 - 1 ulp in binary).
-double srgb_encode(double v) {
-  if (v <= 0.0031308) return 12.92 * v;
-  if (v >= 1) return 1;
-  return std::min(1.0, 1.055 * std::pow(v, 1.0 / 2.4) - 0.055);
-}
-double srgb_decode(double e) {
-  if (e <= 0.04045) return e / 12.92;
-  if (e >= 1) return 1;
-  return std::min(1.0, std::pow((e + 0.055) / 1.055, 2.4));
-}
 
 double clip_unit(double v) {
   if (!(v > 0)) return 0;  // NaN counts as black, not as a poisoned pixel

@@ -1,5 +1,6 @@
 // The simulator's plane textures and sky.
 #include "capture/sim/sim_textures.h"
+#include "core/image/srgb.h"
 
 #include <apriltag/apriltag.h>
 #include <fmt/format.h>
@@ -34,10 +35,6 @@ cv::Mat read_image(const fs::path& path, int flags, const std::string& what) {
 int clamp_index(double x, int n) { return std::clamp(int(x), 0, n - 1); }
 
 }  // namespace
-
-double srgb_to_linear(double encoded) {
-  return encoded <= 0.04045 ? encoded / 12.92 : std::pow((encoded + 0.055) / 1.055, 2.4);
-}
 
 PlaneTexture::PlaneTexture(const SimMaterial& material, const std::string& object_name)
     : kind_(material.texture.kind),
@@ -85,7 +82,7 @@ PlaneTexture::PlaneTexture(const SimMaterial& material, const std::string& objec
       width_ = image.cols;
       height_ = image.rows;
       std::array<float, 256> decode{};
-      for (int i = 0; i < 256; ++i) decode[size_t(i)] = float(srgb_to_linear(i / 255.0));
+      for (int i = 0; i < 256; ++i) decode[size_t(i)] = float(srgb_decode(i / 255.0));
       rgb_.resize(size_t(width_) * height_ * 3);
       for (int row = 0; row < height_; ++row) {
         const uint8_t* bgr = image.ptr<uint8_t>(row);

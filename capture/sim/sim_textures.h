@@ -11,9 +11,6 @@
 
 namespace arpipe::sim {
 
-// IEC 61966-2-1 sRGB decoding of a value in [0, 1].
-double srgb_to_linear(double encoded);
-
 // Linear reflectance over a plane's texture coordinates (u left to right, v top to bottom, both
 // in [0, 1], as sim_scene.h defines them). Two-tone textures are sampled nearest-texel (crisp
 // edges: the camera's area sampling anti-aliases them); image files bilinearly.

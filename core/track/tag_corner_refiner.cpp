@@ -1,6 +1,7 @@
 // Sub-pixel refinement of a detected tag's four corners: each border edge is located from the
 // linear-light intensity profile across it, and the edges are intersected undistorted.
 #include "core/track/tag_corner_refiner.h"
+#include "core/image/srgb.h"
 
 #include <algorithm>
 #include <cmath>
@@ -21,10 +22,6 @@ constexpr double kMinContrast = 0.04;        // linear units: black and white mu
 constexpr double kMaxCornerShiftPx = 1.5;    // a refinement that moves a corner farther is refused
 constexpr double kOutlierFactor = 4.0;       // edge points farther than this times the median are dropped
 constexpr int kMaxProfileSamples = 2 * static_cast<int>(kMaxReachPx / kSampleStepPx) + 1;
-
-double srgb_to_linear(double encoded) {
-  return encoded <= 0.04045 ? encoded / 12.92 : std::pow((encoded + 0.055) / 1.055, 2.4);
-}
 
 // A straight line in normalised coordinates: points p with dot(normal, p) = offset.
 struct Line {
@@ -133,7 +130,7 @@ TagCornerRefiner::TagCornerRefiner(PixelFormat grey_encoding) {
   const bool limited_range = grey_encoding == PixelFormat::YUYV || grey_encoding == PixelFormat::NV12;
   for (int code = 0; code < 256; ++code) {
     const double encoded = limited_range ? (code - 16) / 219.0 : code / 255.0;
-    linear_[code] = static_cast<float>(srgb_to_linear(std::clamp(encoded, 0.0, 1.0)));
+    linear_[code] = static_cast<float>(srgb_decode(std::clamp(encoded, 0.0, 1.0)));
   }
 }
 

@@ -1,6 +1,7 @@
 // Plane textures and the sky map against the tag family's own bit layout, the chessboard rule,
 // sRGB decoding and the equirectangular mapping of sim_scene.h.
 #include "capture/sim/sim_textures.h"
+#include "core/image/srgb.h"
 
 #include <apriltag/apriltag.h>
 #include <gtest/gtest.h>
@@ -51,11 +52,11 @@ SimMaterial tag_material(const std::string& family, int id) {
 }
 
 TEST(SimTexture, SrgbDecodingMatchesTheStandard) {
-  EXPECT_EQ(srgb_to_linear(0.0), 0.0);
-  EXPECT_NEAR(srgb_to_linear(1.0), 1.0, 1e-15);
-  EXPECT_NEAR(srgb_to_linear(0.04045), 0.04045 / 12.92, 1e-15);  // the linear segment's end
-  EXPECT_NEAR(srgb_to_linear(0.5), 0.214041140, 1e-9);           // IEC 61966-2-1 reference value
-  EXPECT_NEAR(srgb_to_linear(128 / 255.0), 0.215860500, 1e-9);
+  EXPECT_EQ(srgb_decode(0.0), 0.0);
+  EXPECT_NEAR(srgb_decode(1.0), 1.0, 1e-15);
+  EXPECT_NEAR(srgb_decode(0.04045), 0.04045 / 12.92, 1e-15);  // the linear segment's end
+  EXPECT_NEAR(srgb_decode(0.5), 0.214041140, 1e-9);           // IEC 61966-2-1 reference value
+  EXPECT_NEAR(srgb_decode(128 / 255.0), 0.215860500, 1e-9);
 }
 
 // The printed cells of a tag, 1 = paper, row 0 on top, from the family's documented layout
@@ -143,8 +144,8 @@ TEST(SimTexture, ImageIsDecodedFromSrgbAndSampledBilinearly) {
   const PlaneTexture texture(m, "poster");
   auto linear = [&](int row, int col) {
     const cv::Vec3b bgr = image.at<cv::Vec3b>(row, col);
-    return Rgb{0.5 * srgb_to_linear(bgr[2] / 255.0), 0.8 * srgb_to_linear(bgr[1] / 255.0),
-               1.0 * srgb_to_linear(bgr[0] / 255.0)};
+    return Rgb{0.5 * srgb_decode(bgr[2] / 255.0), 0.8 * srgb_decode(bgr[1] / 255.0),
+               1.0 * srgb_decode(bgr[0] / 255.0)};
   };
   // Texel centres are exact (to float storage, 1e-7); the corners clamp to the corner texels.
   auto expect_rgb = [](const Rgb& got, const Rgb& want) {

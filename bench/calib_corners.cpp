@@ -1,0 +1,108 @@
+// Benchmark: chessboard corner accuracy against the simulator's truth, for each corner refinement
+// (the finder's own corners, cornerSubPix, cornerSubPix + the X-junction model fit), with the time
+// per image. The capture must be the calib-board scene or share its board layout (9 x 13 inner
+// corners of 20 mm at x = -0.12 + 0.02 i, y = 0.08 - 0.02 j in the world).
+// Usage: calib_corners [--recording DIR] [--board FILE] [--dump FILE]   Prints a markdown table for
+// docs/BENCHMARKS.md. Defaults: build/calib-capture, configs/boards/chessboard-10x14-20mm.toml.
+// --dump writes every corner (refinement, frame, point, true and detected pixel) as a vnl table.
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "calib/board_detector.h"
+#include "calib/calibration_board.h"
+#include "calib/calibration_images.h"
+#include "capture/recording/recording_reader.h"
+#include "core/log.h"
+#include "core/pipeline/monotonic_clock.h"
+
+using namespace arpipe;
+using namespace arpipe::calib;
+
+namespace {
+
+std::vector<Vec3> board_corners_in_world() {
+  std::vector<Vec3> out;
+  for (int j = 0; j < 9; ++j)
+    for (int i = 0; i < 13; ++i) out.push_back({-0.12 + 0.02 * i, 0.08 - 0.02 * j, 0.0});
+  return out;
+}
+
+struct Errors {
+  int frames_found = 0, points = 0;
+  double sum_dx = 0, sum_dy = 0, sum2 = 0, max_px = 0, ms = 0;
+};
+
+const char* name(CornerRefinement refinement) {
+  switch (refinement) {
+    case CornerRefinement::none: return "the finder's own corners";
+    case CornerRefinement::corner_subpix: return "cornerSubPix";
+    case CornerRefinement::model_fit: return "cornerSubPix + X-junction model fit";
+  }
+  return "?";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string recording = "build/calib-capture", board_file = "configs/boards/chessboard-10x14-20mm.toml", dump_file;
+  for (int i = 1; i + 1 < argc; i += 2) {
+    const std::string flag = argv[i];
+    if (flag == "--recording") recording = argv[i + 1];
+    else if (flag == "--board") board_file = argv[i + 1];
+    else if (flag == "--dump") dump_file = argv[i + 1];
+  }
+  log::set_max_level(log::Level::Warning);
+  try {
+    RecordingReader reader(recording);
+    const auto images = images_from_recording(recording);
+    if (reader.ground_truth().size() != reader.frame_count())
+      throw std::runtime_error(recording + ": no ground truth for every frame (not a simulated capture?)");
+    const CalibrationBoard board = load_board(board_file);
+    const std::vector<Vec3> world = board_corners_in_world();
+    std::FILE* dump = dump_file.empty() ? nullptr : std::fopen(dump_file.c_str(), "w");
+    if (!dump_file.empty() && !dump) throw std::runtime_error(dump_file + ": cannot write");
+    if (dump) fmt::print(dump, "# refinement frame point x_true y_true x y\n");
+    fmt::print("Corners against the truth on {} ({} frames, board {}):\n\n", recording, reader.frame_count(), board_file);
+    fmt::print("| refinement | boards found | RMS per coordinate | mean error x, y | largest error | ms per image |\n");
+    fmt::print("|---|---|---|---|---|---|\n");
+    for (const CornerRefinement refinement :
+         {CornerRefinement::none, CornerRefinement::corner_subpix, CornerRefinement::model_fit}) {
+      const BoardDetector detector(board, refinement);
+      Errors e;
+      for (size_t f = 0; f < reader.frame_count(); ++f) {
+        const GreyImage image = images->load(f);
+        const auto start = std::chrono::steady_clock::now();
+        const auto observation = detector.detect(image.pixels.data(), image.width, image.height, size_t(image.width), image.name);
+        e.ms += milliseconds_since(start);
+        if (!observation) continue;
+        ++e.frames_found;
+        const SE3& T_cam_world = reader.ground_truth().at(f).T_cam_world_mid;
+        for (size_t i = 0; i < world.size() && i < observation->pixels.size(); ++i) {
+          const auto truth = reader.camera_model().project(T_cam_world * world[i]);
+          if (observation->weights[i] <= 0 || !truth) continue;
+          const double dx = observation->pixels[i][0] - (*truth)[0], dy = observation->pixels[i][1] - (*truth)[1];
+          e.sum_dx += dx, e.sum_dy += dy, e.sum2 += dx * dx + dy * dy, ++e.points;
+          e.max_px = std::max(e.max_px, std::hypot(dx, dy));
+          if (dump)
+            fmt::print(dump, "{} {} {} {:.4f} {:.4f} {:.4f} {:.4f}\n", int(refinement), f, i, (*truth)[0], (*truth)[1],
+                       observation->pixels[i][0], observation->pixels[i][1]);
+        }
+      }
+      const double n = std::max(e.points, 1);
+      fmt::print("| {} | {} of {} | {:.3f} px | {:+.3f}, {:+.3f} px | {:.2f} px | {:.1f} |\n", name(refinement),
+                 e.frames_found, reader.frame_count(), std::sqrt(e.sum2 / (2 * n)), e.sum_dx / n, e.sum_dy / n, e.max_px,
+                 e.ms / double(reader.frame_count()));
+    }
+    if (dump) std::fclose(dump);
+  } catch (const std::exception& error) {
+    fmt::print(stderr, "calib_corners: {}\n", error.what());
+    return 1;
+  }
+  return 0;
+}
