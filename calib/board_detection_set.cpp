@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "calib/board_detector.h"
+#include "core/geometry/camera_model.h"
 
 namespace arpipe::calib {
 namespace {
@@ -57,7 +58,7 @@ bool error_flag(std::mutex& mutex, const std::exception_ptr& error) {
 }  // namespace
 
 DetectionSet detect_boards(const CalibrationImages& images, const CalibrationBoard& board, int threads,
-                           const std::function<void(int, int)>& progress) {
+                           const std::function<void(int, int)>& progress, const CameraModel* lens) {
   const int total = int(images.count());
   std::vector<ImageOutcome> outcomes(static_cast<size_t>(total));
   std::atomic<int> next{0};
@@ -72,7 +73,9 @@ DetectionSet detect_boards(const CalibrationImages& images, const CalibrationBoa
         ImageOutcome& out = outcomes[size_t(i)];
         out.width = image.width;
         out.height = image.height;
-        out.view = detector.detect(image.pixels.data(), image.width, image.height, size_t(image.width), image.name);
+        out.view = lens ? detector.detect(image.pixels.data(), image.width, image.height, size_t(image.width),
+                                          image.name, *lens)
+                        : detector.detect(image.pixels.data(), image.width, image.height, size_t(image.width), image.name);
       } catch (...) {
         const std::lock_guard lock(error_mutex);
         if (!error) error = std::current_exception();

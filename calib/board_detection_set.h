@@ -10,6 +10,10 @@
 #include "calib/calibration_board.h"
 #include "calib/calibration_images.h"
 
+namespace arpipe {
+class CameraModel;
+}
+
 namespace arpipe::calib {
 
 struct DetectionSet {
@@ -24,7 +28,9 @@ struct DetectionSet {
 // an unreadable image (named); images of different sizes (two named, with their sizes); the board
 // found in none of the images (with what the images seem to show instead when another chessboard
 // size is found in them, the usual mistake being squares counted instead of inner corners).
+// lens: a lens known approximately (a first solve); AprilTag grids then place each tag's centre
+// where that lens puts it (BoardDetector::detect with a lens). Chessboards ignore it.
 DetectionSet detect_boards(const CalibrationImages& images, const CalibrationBoard& board, int threads,
-                           const std::function<void(int, int)>& progress = {});
+                           const std::function<void(int, int)>& progress = {}, const CameraModel* lens = nullptr);
 
 }  // namespace arpipe::calib

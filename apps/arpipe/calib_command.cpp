@@ -7,14 +7,15 @@
 #include <cstdio>
 #include <exception>
 #include <fstream>
+#include <optional>
 #include <thread>
 
 #include "apps/arpipe/commands.h"
 #include "apps/arpipe/progress_bar.h"
-#include "calib/board_detection_set.h"
 #include "calib/calibration_board.h"
 #include "calib/calibration_images.h"
 #include "calib/calibration_report.h"
+#include "calib/calibration_run.h"
 #include "calib/calibration_solver.h"
 #include "calib/corners_vnl.h"
 #include "calib/residual_image.h"
@@ -104,17 +105,25 @@ int run_calib(const Args& args) {
     const calib::CalibrationBoard board = calib::load_board(board_path);
     const auto images = images_glob.empty() ? calib::images_from_recording(recording)
                                             : calib::images_from_glob(images_glob);
-    ProgressBar detection("images");
-    const calib::DetectionSet found = calib::detect_boards(
-        *images, board, threads, [&detection](int done, int total) { detection.update(done, total); });
-    detection.finish();
+    std::optional<ProgressBar> bars[2];  // made when their pass starts: the bar times from its creation
+    calib::CalibrationRunProgress progress;
+    progress.detection = [&bars](int pass, int done, int total) {
+      std::optional<ProgressBar>& bar = bars[pass == 1 ? 0 : 1];
+      if (!bar) bar.emplace(pass == 1 ? "images" : "images (tag centres through the first solve's lens)");
+      bar->update(done, total);
+      if (done == total) bar->finish();
+    };
+    progress.solve = [](int stage, int stages, const std::string& name) {
+      log::info("solve stage {}/{}: {}", stage + 1, stages, name);
+    };
+    const calib::CalibrationRun run = calib::run_calibration(*images, board, options, threads, progress);
+    const calib::DetectionSet& found = run.found;
+    const calib::CalibrationResult& result = run.result;
     log::info("found the board in {} of {} images ({}x{})", found.views.size(), found.images, found.width,
               found.height);
-
-    const calib::CalibrationResult result = calib::solve_calibration(
-        board, found.views, found.width, found.height, options, [](int stage, int stages, const std::string& name) {
-          log::info("solve stage {}/{}: {}", stage + 1, stages, name);
-        });
+    if (run.first_pass_rms_per_point_px)
+      log::info("second pass with the lens: RMS per point {:.3f} px (first pass {:.3f} px)", result.rms_per_point_px,
+                *run.first_pass_rms_per_point_px);
     const calib::CalibrationReport report = calib::make_report(result, found.images, found.without_board);
 
     // The model last: a failure writing the extras leaves no model that looks finished.
