@@ -76,13 +76,26 @@ void CompositeStage::configure(const Config& config) {
   last_error_.clear();
 }
 
+void CompositeStage::prepare(const std::shared_ptr<const CameraModel>& camera_model) noexcept {
+  if (!camera_model || lens_ != LensMode::Undistort) return;
+  try {
+    undistortion(camera_model);
+  } catch (...) {
+    // The cache keeps the error; the frames report it.
+  }
+}
+
+std::shared_ptr<const LensUndistortion> CompositeStage::undistortion(
+    const std::shared_ptr<const CameraModel>& camera_model) {
+  return undistortions_.get(camera_model, [](const CameraModel& model) { return LensUndistortion(model); });
+}
+
 void CompositeStage::camera_picture(FrameContext& ctx) {
   if (lens_ != LensMode::Undistort) {
     pass_through(ctx);
     return;
   }
-  const std::shared_ptr<const LensUndistortion> undistortion =
-      undistortions_.get(ctx.camera_model, [](const CameraModel& model) { return LensUndistortion(model); });
+  const std::shared_ptr<const LensUndistortion> to_pinhole = undistortion(ctx.camera_model);
   if (ctx.camera.width != ctx.camera_model->width() || ctx.camera.height != ctx.camera_model->height())
     throw RenderError(fmt::format("the camera frame is {}x{} but the camera model is for {}x{}", ctx.camera.width,
                                   ctx.camera.height, ctx.camera_model->width(), ctx.camera_model->height()));
@@ -91,8 +104,8 @@ void CompositeStage::camera_picture(FrameContext& ctx) {
   to_rgb24(ctx.camera, distorted_.data);
   ctx.output = Frame::allocate(PixelFormat::RGB24, ctx.camera.width, ctx.camera.height);
   ctx.output.meta = ctx.camera.meta;
-  undistortion->apply(distorted_, ctx.output);
-  ctx.output_camera_model = undistortion->pinhole_core();
+  to_pinhole->apply(distorted_, ctx.output);
+  ctx.output_camera_model = to_pinhole->pinhole_core();
 }
 
 void CompositeStage::process(FrameContext& ctx) noexcept {

@@ -26,6 +26,8 @@ class CompositeStage final : public Stage {
   std::string_view name() const override { return "composite"; }
   // Compiles the shader once; the render stage (configured first) has made the context.
   void configure(const Config& config) override;
+  // With render.lens = "undistort", builds the camera model's undistortion before streaming starts.
+  void prepare(const std::shared_ptr<const CameraModel>& camera_model) noexcept override;
   // ctx.output = the camera picture as RGB24 where nothing virtual is, and
   // encode_srgb(V.rgb + (1 - V.a) * decode_srgb(camera)) inside the drawn rectangle. The camera
   // picture is the camera's sRGB bytes as they were, or, with render.lens = "undistort", the frame
@@ -35,6 +37,7 @@ class CompositeStage final : public Stage {
 
  private:
   void camera_picture(FrameContext& ctx);
+  std::shared_ptr<const LensUndistortion> undistortion(const std::shared_ptr<const CameraModel>& camera_model);
   void composite(FrameContext& ctx);
   void ensure_targets(int width, int height);
 

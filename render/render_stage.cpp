@@ -106,6 +106,29 @@ void RenderStage::configure(const Config& config) {
   last_error_.clear();
 }
 
+void RenderStage::prepare(const std::shared_ptr<const CameraModel>& camera_model) noexcept {
+  if (!camera_model || !settings_.enabled || objects_.empty()) return;
+  try {
+    if (settings_.lens == LensMode::Map) warp_map(camera_model);
+    if (settings_.lens == LensMode::Undistort) pinhole_core(camera_model);
+  } catch (...) {
+    // The cache keeps the error; the frames report it.
+  }
+}
+
+std::shared_ptr<const LensWarpMap> RenderStage::warp_map(const std::shared_ptr<const CameraModel>& camera_model) {
+  return warp_maps_.get(camera_model, [scale = settings_.lens_canvas_scale](const CameraModel& model) {
+    return LensWarpMap(model, scale);
+  });
+}
+
+std::shared_ptr<const CameraModel> RenderStage::pinhole_core(const std::shared_ptr<const CameraModel>& camera_model) {
+  return pinhole_cores_.get(camera_model, [](const CameraModel& model) {
+    check_lens_undistortable(model);
+    return CameraModel::pinhole(model.fx(), model.fy(), model.cx(), model.cy(), model.width(), model.height());
+  });
+}
+
 void RenderStage::process(FrameContext& ctx) noexcept {
   const auto start = std::chrono::steady_clock::now();
   ctx.virtual_layer_drawn = false;
@@ -145,13 +168,9 @@ void RenderStage::draw(FrameContext& ctx) {
   if (settings_.lens == LensMode::Vertex) check_lens_model_supported(camera);
   // What the output picture sees: the camera's lens, or its pinhole core when the composite
   // stage undistorts the camera frame.
-  std::shared_ptr<const CameraModel> pinhole_core;
-  if (settings_.lens == LensMode::Undistort)
-    pinhole_core = pinhole_cores_.get(ctx.camera_model, [](const CameraModel& model) {
-      check_lens_undistortable(model);
-      return CameraModel::pinhole(model.fx(), model.fy(), model.cx(), model.cy(), model.width(), model.height());
-    });
-  const CameraModel& image_camera = pinhole_core ? *pinhole_core : camera;
+  const std::shared_ptr<const CameraModel> core =
+      settings_.lens == LensMode::Undistort ? pinhole_core(ctx.camera_model) : nullptr;
+  const CameraModel& image_camera = core ? *core : camera;
 
   struct Visible {
     const RenderObject* object;
@@ -172,9 +191,7 @@ void RenderStage::draw(FrameContext& ctx) {
   // "map": draw on the pinhole canvas, in the part of it that the output rectangle samples.
   std::shared_ptr<const LensWarpMap> warp;
   if (settings_.lens == LensMode::Map) {
-    warp = warp_maps_.get(ctx.camera_model, [scale = settings_.lens_canvas_scale](const CameraModel& model) {
-      return LensWarpMap(model, scale);
-    });
+    warp = warp_map(ctx.camera_model);
     if (warp->identity()) warp.reset();  // a pinhole lens: the canvas is the image
   }
   const LensUniforms lens = warp ? lens_uniforms(warp->canvas().model()) : lens_uniforms(image_camera);

@@ -27,10 +27,13 @@ class RenderStage final : public Stage {
   // Creates the GL context on the first call (on this thread), compiles the shaders once, and
   // loads the meshes; throws RenderError, ConfigError or AssetError and then keeps the old setup.
   void configure(const Config& config) override;
+  // With render.lens = "map", builds the camera model's warp map (mrcal, a few hundred ms at
+  // 640x480) before streaming starts; "undistort": its pinhole core. A frame with another model
+  // builds its own on its first drawn frame.
+  void prepare(const std::shared_ptr<const CameraModel>& camera_model) noexcept override;
   // Skips (ctx.virtual_layer_drawn = false, reason recorded) when rendering is off, there are no
   // objects, the pose is not Tracking, or no object's box reaches into the image; such frames do
-  // no GL work. With render.lens = "map" the first drawn frame of a camera model builds its warp
-  // map (mrcal, a few hundred ms at 640x480), kept for later frames.
+  // no GL work.
   void process(FrameContext& ctx) noexcept override;
 
  private:
@@ -44,6 +47,8 @@ class RenderStage final : public Stage {
     double lens_canvas_scale = 1.5;
   };
   void draw(FrameContext& ctx);
+  std::shared_ptr<const LensWarpMap> warp_map(const std::shared_ptr<const CameraModel>& camera_model);
+  std::shared_ptr<const CameraModel> pinhole_core(const std::shared_ptr<const CameraModel>& camera_model);
 
   std::shared_ptr<RenderSession> session_;  // first member: outlives the GL objects below
   GlProgram program_;

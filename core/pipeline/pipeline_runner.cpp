@@ -38,6 +38,7 @@ void PipelineRunner::start() {
     try {
       stages_ = stage_factory_();
       for (auto& stage : stages_) stage->configure(config_);
+      for (auto& stage : stages_) stage->prepare(source_->camera_model());
     } catch (...) {
       stages_.clear();
       configured.set_exception(std::current_exception());
@@ -198,6 +199,7 @@ void PipelineRunner::apply_pending_reconfigure() {
   } else {
     config_ = request->config;
   }
+  for (auto& stage : stages_) stage->prepare(source_->camera_model());
   request->result.set_value(error);
 }
 

@@ -2,6 +2,7 @@
 // process() never throws: a problem with one frame is recorded in the FrameContext.
 #pragma once
 
+#include <memory>
 #include <string_view>
 
 #include "core/config/config.h"
@@ -16,6 +17,11 @@ class Stage {
   // Called before the first frame and again on a config reload. May throw ConfigError (or any
   // std::exception) to refuse the config; the stage then keeps its previous configuration.
   virtual void configure(const Config& config) = 0;
+  // Called after each configure, before the next frame, with the source's camera model (null when
+  // it has none): the place to build what depends on the lens (a warp map takes a few hundred ms),
+  // so that the first frames do not stall. Must not throw: a lens the stage cannot use shows up on
+  // the frames, as it would without this call.
+  virtual void prepare(const std::shared_ptr<const CameraModel>& camera_model) noexcept { (void)camera_model; }
   // Per frame. Must not throw. Records its own timing (and skip reason) in ctx.
   virtual void process(FrameContext& ctx) noexcept = 0;
 };
