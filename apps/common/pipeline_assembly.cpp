@@ -7,6 +7,7 @@
 #include "capture/sinks/recording_sink.h"
 #include "capture/sinks/results_sink.h"
 #include "capture/sinks/y4m_sink.h"
+#include "core/motion/motion_stage.h"
 #include "core/track/tag_tracker.h"
 #include "render/lens_mode.h"
 #include "render/render_stages.h"
@@ -29,10 +30,14 @@ std::vector<std::unique_ptr<FrameSink>> make_sinks(const Config& config) {
   return sinks;
 }
 
-StageFactory make_stage_factory() {
-  return [] {
+StageFactory make_stage_factory(const Config& config) {
+  // The motion stage needs the tracker's poses. It stays out of the list when disabled (a config
+  // reload cannot add it; it can switch it off, since the stage checks motion.enabled per frame).
+  const bool motion = config.track.enabled && config.motion.enabled;
+  return [motion] {
     std::vector<std::unique_ptr<Stage>> stages;
     stages.push_back(std::make_unique<TagTracker>());
+    if (motion) stages.push_back(std::make_unique<MotionStage>());
     for (auto& stage : make_render_stages()) stages.push_back(std::move(stage));
     return stages;
   };
@@ -59,7 +64,7 @@ std::unique_ptr<PipelineRunner> assemble_pipeline(const Config& config) {
     }
   }
   auto sinks = make_sinks(config);
-  return std::make_unique<PipelineRunner>(std::move(source), make_stage_factory(), std::move(sinks), config);
+  return std::make_unique<PipelineRunner>(std::move(source), make_stage_factory(config), std::move(sinks), config);
 }
 
 std::string describe_metrics(const PipelineMetrics& m) {

@@ -11,8 +11,9 @@ namespace arpipe {
 
 std::unique_ptr<FrameSource> make_source(const Config& config);
 std::vector<std::unique_ptr<FrameSink>> make_sinks(const Config& config);
-// track, render, composite (in that order), created on the processing thread.
-StageFactory make_stage_factory();
+// track, motion (when tracking and motion are enabled), render, composite (in that order), created
+// on the processing thread. The default config has both on.
+StageFactory make_stage_factory(const Config& config = Config{});
 // All of the above in a runner (not started).
 std::unique_ptr<PipelineRunner> assemble_pipeline(const Config& config);
 

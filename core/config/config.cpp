@@ -285,6 +285,27 @@ void read_track(const ConfigReader& r, const toml::table& t, TrackConfig& out) {
   // Without a bundle key the default bundle (tag 0) stays, and tag 0 exists in every family.
 }
 
+void read_motion(const ConfigReader& r, const toml::table& t, MotionConfig& out) {
+  const std::string p = "motion.";
+  r.check_keys(t, p, {"enabled", "latency_frames", "default_exposure_ms"}, "[motion]");
+  r.read(t, p, "enabled", out.enabled);
+  // Only the previous-current (0) or current-next (1) segment is implemented; holding more
+  // frames would add latency without a better estimate of one exposure.
+  r.read(t, p, "latency_frames", out.latency_frames);
+  if (out.latency_frames != 0 && out.latency_frames != 1)
+    r.fail_got(*t.get("latency_frames"), p + "latency_frames",
+               "0 (extrapolate, no delay) or 1 (hold each frame back by one and interpolate)",
+               fmt::format("{}", out.latency_frames));
+  if (const toml::node* node = t.get("default_exposure_ms")) {
+    double ms = 0;
+    // Up to one second: longer than any frame interval a tracking camera runs at. The stage caps it
+    // at each frame's own interval, and frames with their own exposure never use it.
+    r.read(t, p, "default_exposure_ms", ms, [](double v) { return v > 0 && v <= 1000; }, "a number in (0, 1000] (ms)");
+    out.default_exposure_ns = std::llround(ms * 1e6);
+    if (out.default_exposure_ns <= 0) r.fail_got(*node, p + "default_exposure_ms", "at least 1 ns", format_toml_float(ms));
+  }
+}
+
 void read_render(const ConfigReader& r, const toml::table& t, RenderConfig& out) {
   const std::string p = "render.";
   r.check_keys(t, p,
@@ -361,9 +382,10 @@ Config read_config(const toml::table& root, const std::string& source) {
   const ConfigReader r(source);
   Config config;
   config.file = source;
-  r.check_keys(root, "", {"source", "track", "render", "sinks", "pipeline"}, "the top level");
+  r.check_keys(root, "", {"source", "track", "motion", "render", "sinks", "pipeline"}, "the top level");
   if (const toml::table* t = r.table(root, "", "source")) read_source(r, *t, config.source);
   if (const toml::table* t = r.table(root, "", "track")) read_track(r, *t, config.track);
+  if (const toml::table* t = r.table(root, "", "motion")) read_motion(r, *t, config.motion);
   if (const toml::table* t = r.table(root, "", "render")) read_render(r, *t, config.render);
   if (const toml::table* t = r.table(root, "", "sinks")) read_sinks(r, *t, config.sinks);
   if (const toml::table* t = r.table(root, "", "pipeline")) read_pipeline(r, *t, config.pipeline);
@@ -551,6 +573,13 @@ std::string default_config_toml() {
     entry("center_m", vec(tag.center_m), "tag centre in the world frame");
     entry("yaw_deg", f(tag.yaw_rad / kRadiansPerDegree), "turn of the tag's x axis about world z");
   }
+
+  out += "\n[motion]                       # the camera's poses over each exposure (needs tracking)\n";
+  entry("enabled", b(d.motion.enabled));
+  entry("latency_frames", fmt::format("{}", d.motion.latency_frames),
+        "0: extrapolate at constant velocity; 1: hold a frame back and interpolate");
+  entry("default_exposure_ms", f(double(d.motion.default_exposure_ns) * 1e-6),
+        "(0, 1000]: for frames without an exposure time; capped at the frame interval");
 
   out += "\n[render]\n";
   entry("enabled", b(d.render.enabled));

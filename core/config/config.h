@@ -58,6 +58,19 @@ struct TrackConfig {
   bool operator==(const TrackConfig&) const = default;
 };
 
+// The shutter-motion stage (core/motion): the camera's poses over each exposure.
+struct MotionConfig {
+  bool enabled = true;  // runs only while tracking is on
+  // 0: the output may not lag, so the end of each exposure is extrapolated at constant velocity;
+  // 1: the frame is held back by one, so start and end are interpolated with the next frame's pose.
+  int latency_frames = 0;
+  // Used for frames whose metadata has no exposure time (then flagged in the result). A typical
+  // indoor auto-exposure at 30 fps.
+  int64_t default_exposure_ns = 10'000'000;
+
+  bool operator==(const MotionConfig&) const = default;
+};
+
 struct SceneObject {
   std::string mesh = "builtin:cube";   // "builtin:cube", "builtin:pyramid", or a glTF 2.0 file
   Vec3 position_m{0, 0, 0};            // in the world (anchor) frame
@@ -139,6 +152,7 @@ struct Config {
   std::filesystem::path file;  // where it came from, for messages
   SourceConfig source;
   TrackConfig track;
+  MotionConfig motion;
   RenderConfig render;
   SinksConfig sinks;
   PipelineConfig pipeline;

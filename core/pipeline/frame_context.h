@@ -11,6 +11,7 @@
 #include "core/frame.h"
 #include "core/geometry/camera_model.h"
 #include "core/geometry/se3.h"
+#include "core/motion/shutter_motion.h"
 
 namespace arpipe {
 
@@ -47,6 +48,8 @@ struct FrameContext {
   Frame camera;                                 // the input frame, in the source's pixel format
   std::shared_ptr<const CameraModel> camera_model;
   PoseEstimate pose;
+  // The camera's motion over this frame's exposure (the motion stage); state None until then.
+  ShutterMotion motion;
   Frame output;                                 // the composited frame, RGB24; empty until composed
   // The lens that ctx.output is seen through: camera_model, or its pinhole core when render.lens
   // is "undistort" (the output is then an undistorted picture). Set with ctx.output.

@@ -1,6 +1,7 @@
 #include "core/pipeline/pipeline_runner.h"
 
 #include <chrono>
+#include <deque>
 #include <exception>
 #include <future>
 
@@ -103,29 +104,55 @@ void PipelineRunner::capture_loop() {
   to_process_->close();
 }
 
+size_t PipelineRunner::first_stage_with_latency() const {
+  for (size_t i = 0; i < stages_.size(); ++i)
+    if (stages_[i]->latency_frames() > 0) return i;
+  return stages_.size();
+}
+
+void PipelineRunner::finish_frame(FrameContext& ctx, size_t first_stage) {
+  for (size_t i = first_stage; i < stages_.size(); ++i) stages_[i]->process(ctx);
+  {
+    std::lock_guard lock(metrics_mutex_);
+    for (const auto& t : ctx.timings) {
+      auto& stats = metrics_.stages[t.stage];
+      ++stats.runs;
+      stats.total_ms += t.ms;
+      if (!t.skipped.empty()) ++stats.skips[t.skipped];
+    }
+    if (ctx.pose.state == TrackState::Tracking) ++metrics_.frames_tracked;
+    if (ctx.pose.state == TrackState::Lost) ++metrics_.frames_lost;
+  }
+  to_sink_->push(std::move(ctx));
+}
+
 void PipelineRunner::processing_loop() {
   uint64_t expected_index = 0;
+  // Frames held back for a stage with latency_frames() > 0 (the motion stage with
+  // motion.latency_frames = 1), each with the first stage it has still to go through.
+  std::deque<std::pair<FrameContext, size_t>> held;
+  const auto finish_held = [&](size_t keep) {
+    for (; held.size() > keep; held.pop_front()) finish_frame(held.front().first, held.front().second);
+  };
   while (auto ctx = to_process_->pop()) {
     busy_since_ns_ = monotonic_now_ns();
     // Frames the live queue dropped are lost just like a sequence gap, so the next frame says so.
     ctx->dropped_before += ctx->input_index - expected_index;
     expected_index = ctx->input_index + 1;
     apply_pending_reconfigure();
-    for (auto& stage : stages_) stage->process(*ctx);
-    {
-      std::lock_guard lock(metrics_mutex_);
-      for (const auto& t : ctx->timings) {
-        auto& stats = metrics_.stages[t.stage];
-        ++stats.runs;
-        stats.total_ms += t.ms;
-        if (!t.skipped.empty()) ++stats.skips[t.skipped];
-      }
-      if (ctx->pose.state == TrackState::Tracking) ++metrics_.frames_tracked;
-      if (ctx->pose.state == TrackState::Lost) ++metrics_.frames_lost;
+    const size_t split = first_stage_with_latency();
+    for (size_t i = 0; i < split; ++i) stages_[i]->process(*ctx);
+    if (split < stages_.size()) {
+      stages_[split]->look_ahead(*ctx);
+      held.emplace_back(std::move(*ctx), split);
+      finish_held(size_t(stages_[split]->latency_frames()));
+    } else {
+      finish_held(0);  // held under a config that has since dropped the latency
+      finish_frame(*ctx, split);
     }
     busy_since_ns_ = 0;
-    to_sink_->push(std::move(*ctx));
   }
+  finish_held(0);  // the end of the stream: the last frames go on without a look-ahead
   to_sink_->close();
   {
     std::lock_guard lock(reconfigure_mutex_);

@@ -48,6 +48,10 @@ class PipelineRunner {
  private:
   void capture_loop();
   void processing_loop();
+  // The first stage that holds frames back (Stage::latency_frames() > 0), or stages_.size().
+  size_t first_stage_with_latency() const;
+  // Runs the stages from first_stage on, counts the frame in the metrics and hands it to the sinks.
+  void finish_frame(FrameContext& ctx, size_t first_stage);
   void sink_loop();
 
   std::unique_ptr<FrameSource> source_;

@@ -24,6 +24,12 @@ class Stage {
   virtual void prepare(const std::shared_ptr<const CameraModel>& camera_model) noexcept { (void)camera_model; }
   // Per frame. Must not throw. Records its own timing (and skip reason) in ctx.
   virtual void process(FrameContext& ctx) noexcept = 0;
+  // How many later frames this stage wants to have seen before it processes a frame (the motion
+  // stage interpolates a frame's exposure end towards the next frame's pose). The runner then holds
+  // each frame back after the stages before this one and shows the stage each arriving frame
+  // through look_ahead() first; at the end of the stream the held frames go on without.
+  virtual int latency_frames() const noexcept { return 0; }
+  virtual void look_ahead(const FrameContext& next) noexcept { (void)next; }
 };
 
 }  // namespace arpipe

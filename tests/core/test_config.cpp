@@ -68,7 +68,7 @@ TEST(Config, DefaultTomlReadsBackAsTheDefaultConfigAndListsEveryKey) {
        {"[source]", "type = ", "path = ", "pacing = ", "loop = ", "timestamp_offset_ns = ", "camera_model = ",
         "[track]", "enabled = ", "family = ", "quad_decimate = ", "quad_sigma = ", "threads = ", "max_hamming = ",
         "min_decision_margin = ", "ambiguity_ratio = ", "[[track.bundle]]", "id = ", "size_m = ", "center_m = ",
-        "yaw_deg = ", "[render]", "light_direction = ", "light_color = ", "ambient = ", "msaa_samples = ",
+        "yaw_deg = ", "[motion]", "latency_frames = ", "default_exposure_ms = ", "[render]", "light_direction = ", "light_color = ", "ambient = ", "msaa_samples = ",
         "egl_platform = ", "lens = ", "lens_canvas_scale = ", "[[render.objects]]", "mesh = ", "position_m = ",
         "scale = ", "color = ", "[sinks.png]", "dir = ", "every = ", "[sinks.y4m]", "[sinks.recording]",
         "[sinks.results]", "[pipeline]", "queue_depth = ", "max_frames = ", "log_level = "})
@@ -215,7 +215,7 @@ TEST(Config, UnknownKeysAreErrorsWithPlaceAndAllowedKeys) {
                {"test.toml:3:1:", "unknown key 'track.famliy'", "allowed keys in [track]:", "family", "bundle",
                 "ambiguity_ratio"});
   expect_error("\n\n[tracking]\nenabled = true\n",
-               {"test.toml:3:", "unknown key 'tracking'", "source, track, render, sinks, pipeline"});
+               {"test.toml:3:", "unknown key 'tracking'", "source, track, motion, render, sinks, pipeline"});
   expect_error("typo = 1\n", {"test.toml:1:1:", "unknown key 'typo'"});
   expect_error("[sinks.png]\nenabled = true\nquality = 9\n",
                {"test.toml:3:1:", "unknown key 'sinks.png.quality'", "allowed keys in [sinks.png]: enabled, dir, every"});
@@ -366,6 +366,36 @@ TEST(Config, OverridesReplaceKeysBeforeValidation) {
   ASSERT_EQ(e.track.bundle.size(), 2u);
   EXPECT_EQ(e.track.bundle[0].id, 5);
   EXPECT_EQ(e.track.bundle[1].id, 6);
+}
+
+TEST(Config, MotionKeysHaveTheirDefaultsAndReadBack) {
+  const Config d;
+  EXPECT_TRUE(d.motion.enabled);
+  EXPECT_EQ(d.motion.latency_frames, 0);
+  EXPECT_EQ(d.motion.default_exposure_ns, 10'000'000);
+  const Config c = parse_config("[motion]\nenabled = false\nlatency_frames = 1\ndefault_exposure_ms = 2.5\n", "m.toml");
+  EXPECT_FALSE(c.motion.enabled);
+  EXPECT_EQ(c.motion.latency_frames, 1);
+  EXPECT_EQ(c.motion.default_exposure_ns, 2'500'000);
+  // Integers are numbers too, and the override path is validated like the file.
+  EXPECT_EQ(parse_config("[motion]\ndefault_exposure_ms = 4\n", "m.toml").motion.default_exposure_ns, 4'000'000);
+  EXPECT_EQ(parse_config("", "m.toml", {"motion.latency_frames=1"}).motion.latency_frames, 1);
+}
+
+TEST(Config, MotionValuesOutOfRangeAreRefusedNamingFileAndKey) {
+  expect_error("[motion]\nlatency_frames = 2\n",
+               {"test.toml:2:", "'motion.latency_frames' expected 0 (extrapolate, no delay) or 1", "got 2"});
+  expect_error("[motion]\nlatency_frames = -1\n", {"test.toml:2:", "'motion.latency_frames'", "got -1"});
+  expect_error("[motion]\nlatency_frames = 1.0\n", {"'motion.latency_frames' expected an integer", "got a float"});
+  expect_error("[motion]\ndefault_exposure_ms = 0\n",
+               {"test.toml:2:", "'motion.default_exposure_ms' expected a number in (0, 1000] (ms), got 0.0"});
+  expect_error("[motion]\ndefault_exposure_ms = -3\n", {"'motion.default_exposure_ms'", "got -3.0"});
+  expect_error("[motion]\ndefault_exposure_ms = 1500\n", {"'motion.default_exposure_ms'", "got 1500.0"});
+  expect_error("[motion]\ndefault_exposure_ms = \"8\"\n", {"'motion.default_exposure_ms'", "got a string"});
+  expect_error("[motion]\nenabled = 1\n", {"'motion.enabled' expected a boolean"});
+  expect_error("[motion]\nlatency = 1\n",
+               {"test.toml:2:1:", "unknown key 'motion.latency'", "enabled, latency_frames, default_exposure_ms"});
+  expect_error("", {"override 'motion.latency_frames=3'", "got 3"}, {"motion.latency_frames=3"});
 }
 
 TEST(Config, BadOverridesAreErrorsNamingTheOverride) {

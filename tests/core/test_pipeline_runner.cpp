@@ -129,6 +129,7 @@ class FakeSource : public FrameSource {
 struct StageLog : SharedLog {
   std::vector<std::string> configured;  // the pipeline.log_level of every configure() call, accepted or not
   std::vector<uint64_t> processed;      // sequence numbers
+  std::vector<std::string> events;      // "look N" and "process N" in the order they happened
   bool inside_process = false;
 };
 
@@ -147,6 +148,7 @@ struct StageBehaviour {
   bool refuse_first_configure = false;
   double ms = 0.25;                       // the timing it records; exact in binary, so sums are exact
   bool skip_odd_sequences = false;        // records a skip reason on odd sequence numbers
+  int latency = 0;                        // Stage::latency_frames
   std::function<void(const FrameContext&)> while_processing;  // delays or blocks, as a test needs
 
   static StageBehaviour named(std::string name) {
@@ -167,6 +169,11 @@ struct StageBehaviour {
   StageBehaviour timing(double stage_ms) const {
     auto b = *this;
     b.ms = stage_ms;
+    return b;
+  }
+  StageBehaviour holding_back(int frames) const {
+    auto b = *this;
+    b.latency = frames;
     return b;
   }
   StageBehaviour skipping_odd_sequences() const {
@@ -212,8 +219,15 @@ class FakeStage : public Stage {
     ctx.record_timing(behaviour_.name, behaviour_.ms, skip ? "odd frame" : "");
     std::lock_guard lock(log_->mutex);
     log_->processed.push_back(ctx.camera.meta.sequence);
+    log_->events.push_back(fmt::format("process {}", ctx.camera.meta.sequence));
     log_->inside_process = false;
     log_->changed.notify_all();
+  }
+
+  int latency_frames() const noexcept override { return behaviour_.latency; }
+  void look_ahead(const FrameContext& next) noexcept override {
+    std::lock_guard lock(log_->mutex);
+    log_->events.push_back(fmt::format("look {}", next.camera.meta.sequence));
   }
 
  private:
@@ -395,6 +409,31 @@ TEST(PipelineRunner, ReplayDeliversEveryFrameToEverySinkOnceAndInOrder) {
   EXPECT_EQ(m.stages.at("second").runs, kFrames);
   EXPECT_EQ(m.stages.at("second").total_ms, 1.5 * kFrames);
   EXPECT_TRUE(m.stages.at("second").skips.empty());
+}
+
+TEST(PipelineRunner, StageThatHoldsFramesBackSeesTheNextFrameFirstAndNothingIsLost) {
+  // The motion stage with motion.latency_frames = 1: each frame waits, after the stages before it,
+  // until the next one has been through them and shown to the stage; the last goes on at the end.
+  constexpr uint64_t kFrames = 10;
+  Harness h(Setup::replaying(frames_0_to(kFrames))
+                .with_stages({StageBehaviour::named("before"), StageBehaviour::named("held").holding_back(1),
+                              StageBehaviour::named("after")}));
+  h.runner->start();
+  h.runner->wait();
+  const auto& sink = *h.sink_logs[0];
+  EXPECT_EQ(sink.sequences, iota(kFrames));
+  EXPECT_EQ(sink.flushes, 1);
+  EXPECT_EQ(sink.frames_after_flush, 0);
+  for (const auto& order : sink.stage_order) EXPECT_EQ(order, (std::vector<std::string>{"before", "held", "after"}));
+  std::vector<std::string> expected{"look 0"};
+  for (uint64_t s = 1; s < kFrames; ++s) {
+    expected.push_back(fmt::format("look {}", s));
+    expected.push_back(fmt::format("process {}", s - 1));
+  }
+  expected.push_back(fmt::format("process {}", kFrames - 1));
+  EXPECT_EQ(h.stage_logs[1]->events, expected);
+  for (const auto& log : h.stage_logs) EXPECT_EQ(log->processed, iota(kFrames));
+  EXPECT_EQ(h.runner->metrics().frames_out, kFrames);
 }
 
 TEST(PipelineRunner, LiveSourceDropsOldestWhenProcessingFallsBehindAndCountsExactly) {
