@@ -100,8 +100,9 @@ int run_daemon(const DaemonOptions& options) {
     const int64_t now = monotonic_now_ns();
     if (now - last_status_ns > 2'000'000'000) {
       const auto m = runner->metrics();
-      systemd.status(fmt::format("{} frames, {:.1f} frames/s, tracked {}, lost {}, drops {}", m.frames_out, m.fps(),
-                                 m.frames_tracked, m.frames_lost, m.sequence_gaps + m.queue_drops));
+      systemd.status(fmt::format("{} frames, {:.1f} frames/s, tracked {}, predicted {}, lost {}, drops {}",
+                                 m.frames_out, m.fps(), m.frames_tracked, m.frames_predicted, m.frames_lost,
+                                 m.sequence_gaps + m.queue_drops));
       last_status_ns = now;
     }
   }

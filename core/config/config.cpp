@@ -245,7 +245,7 @@ void read_track(const ConfigReader& r, const toml::table& t, TrackConfig& out) {
   const std::string p = "track.";
   r.check_keys(t, p,
                {"enabled", "family", "bundle", "quad_decimate", "quad_sigma", "threads", "max_hamming",
-                "min_decision_margin", "ambiguity_ratio", "refine_corners"},
+                "min_decision_margin", "ambiguity_ratio", "refine_corners", "max_predicted_frames"},
                "[track]");
   r.read(t, p, "enabled", out.enabled);
   std::vector<std::string> families;
@@ -258,6 +258,8 @@ void read_track(const ConfigReader& r, const toml::table& t, TrackConfig& out) {
   r.read(t, p, "min_decision_margin", out.min_decision_margin, non_negative, "a number >= 0");
   r.read(t, p, "ambiguity_ratio", out.ambiguity_ratio, [](double v) { return v >= 1; }, "a number >= 1");
   r.read(t, p, "refine_corners", out.refine_corners);
+  // A second of prediction at 30 fps is already far beyond what constant velocity predicts well.
+  r.read(t, p, "max_predicted_frames", out.max_predicted_frames, 0, 30);
 
   if (const toml::array* bundle = r.array_of_tables(t, p, "bundle")) {
     const int64_t code_count = create_tag_family(out.family)->ncodes;
@@ -565,6 +567,8 @@ std::string default_config_toml() {
   entry("min_decision_margin", f(d.track.min_decision_margin), "weaker detections are ignored");
   entry("ambiguity_ratio", f(d.track.ambiguity_ratio), ">= 1: IPPE's two poses closer than this error ratio are ambiguous");
   entry("refine_corners", b(d.track.refine_corners), "re-fit the tag borders in linear light (libapriltag's corners sit ~0.2 px inside)");
+  entry("max_predicted_frames", fmt::format("{}", d.track.max_predicted_frames),
+        "0..30: frames without a detection whose pose is predicted at constant velocity (0: none)");
   out += "\n# The anchor: one [[track.bundle]] per tag, placed in the world (anchor) frame, lying in z = 0.\n";
   for (const BundleTag& tag : d.track.bundle) {
     out += "[[track.bundle]]\n";

@@ -54,6 +54,9 @@ struct TrackConfig {
   // Re-fit the tag's border edges in linear light before solving: libapriltag's corners sit about
   // 0.2 px inside the true ones (bench/pose_accuracy measures what this buys and costs).
   bool refine_corners = true;
+  // Frames without a detection that still get a pose, predicted at constant velocity from the last
+  // two measured ones (state Predicted); beyond this the state is Lost. 0: no prediction.
+  int max_predicted_frames = 3;
 
   bool operator==(const TrackConfig&) const = default;
 };

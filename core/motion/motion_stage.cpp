@@ -77,7 +77,10 @@ std::string MotionStage::Impl::estimate(FrameContext& ctx) {
   if (!config.enabled) return "disabled";
   if (!tracking_on) return "tracking disabled";
   if (ctx.pose.state != TrackState::Tracking) {
-    motion.why_none = ctx.pose.state == TrackState::Lost ? "no pose: tracking lost" : "no pose: tracking did not run";
+    // A predicted pose is the tracker's own extrapolation: no measurement to derive motion from.
+    motion.why_none = ctx.pose.state == TrackState::Lost        ? "no pose: tracking lost"
+                      : ctx.pose.state == TrackState::Predicted ? "no measured pose: the pose is predicted"
+                                                                : "no pose: tracking did not run";
     return std::string(motion.why_none);
   }
   observe(ctx);

@@ -6,6 +6,7 @@ std::string_view track_state_name(TrackState state) {
   switch (state) {
     case TrackState::NotRun: return "not_run";
     case TrackState::Tracking: return "tracking";
+    case TrackState::Predicted: return "predicted";
     case TrackState::Lost: return "lost";
   }
   return "?";

@@ -17,8 +17,9 @@ namespace arpipe {
 
 enum class TrackState {
   NotRun,    // tracking disabled or skipped
-  Tracking,  // pose measured on this frame
-  Lost,      // no anchor tag found on this frame
+  Tracking,   // pose measured on this frame
+  Predicted,  // no anchor tag found; pose extrapolated at constant velocity from the last two measured
+  Lost,       // no anchor tag found on this frame (and none recently enough to predict from)
 };
 std::string_view track_state_name(TrackState state);
 
@@ -31,10 +32,16 @@ struct TagObservation {
 
 struct PoseEstimate {
   TrackState state = TrackState::NotRun;
-  SE3 T_cam_world;              // valid when state == Tracking
+  SE3 T_cam_world;              // valid when state == Tracking or Predicted
   double reprojection_rms_px = 0;
   bool ambiguous = false;       // IPPE's two solutions were close; temporal consistency chose
   int tags_used = 0;
+  // Predicted only: frames since the last measured pose (0 when Tracking), and how far the
+  // prediction may be off. The growth model (tag_tracker.cpp): the displacement extrapolated since
+  // the last measurement, i.e. the error if the camera had stopped there; linear in the time.
+  int frames_since_measured = 0;
+  double predicted_uncertainty_deg = 0;
+  double predicted_uncertainty_mm = 0;  // camera centre
   std::vector<TagObservation> tags;  // every detection of the bundle's family on this frame
 };
 

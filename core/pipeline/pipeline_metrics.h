@@ -20,6 +20,7 @@ struct PipelineMetrics {
   uint64_t queue_drops = 0;       // frames dropped because processing fell behind (live only)
   uint64_t source_retries = 0;
   uint64_t frames_tracked = 0;
+  uint64_t frames_predicted = 0;  // no detection, pose extrapolated (TrackState::Predicted)
   uint64_t frames_lost = 0;
   std::map<std::string, StageStats> stages;
   double wall_seconds = 0;

@@ -121,6 +121,7 @@ void PipelineRunner::finish_frame(FrameContext& ctx, size_t first_stage) {
       if (!t.skipped.empty()) ++stats.skips[t.skipped];
     }
     if (ctx.pose.state == TrackState::Tracking) ++metrics_.frames_tracked;
+    if (ctx.pose.state == TrackState::Predicted) ++metrics_.frames_predicted;
     if (ctx.pose.state == TrackState::Lost) ++metrics_.frames_lost;
   }
   to_sink_->push(std::move(ctx));

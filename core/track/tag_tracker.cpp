@@ -5,11 +5,14 @@
 #include <fmt/format.h>
 
 #include <chrono>
+#include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <optional>
 #include <unordered_map>
 #include <vector>
 
+#include "core/geometry/se3_interpolation.h"
 #include "core/image/pixel_convert.h"
 #include "core/log.h"
 #include "core/pipeline/monotonic_clock.h"
@@ -56,6 +59,10 @@ void validate(const Config& config, const TagDetector& detector) {
     throw ConfigError(fmt::format("{}: track.min_decision_margin: expected a number >= 0, got {}", source,
                                   track.min_decision_margin));
   }
+  if (track.max_predicted_frames < 0 || track.max_predicted_frames > 30) {
+    throw ConfigError(fmt::format("{}: track.max_predicted_frames: expected 0 to 30, got {}", source,
+                                  track.max_predicted_frames));
+  }
   if (!(track.ambiguity_ratio >= 1) || !std::isfinite(track.ambiguity_ratio)) {
     throw ConfigError(
         fmt::format("{}: track.ambiguity_ratio: expected a number >= 1, got {}", source, track.ambiguity_ratio));
@@ -67,6 +74,9 @@ void validate(const Config& config, const TagDetector& detector) {
 struct TagTracker::Impl {
   TrackConfig config;
   std::unique_ptr<TagDetector> detector;
+  // The search near a prediction: the same detector at full resolution (quad_decimate 1), which
+  // finds the smeared quads of a blurred tag that the decimated pass misses, run on a small crop.
+  std::unique_ptr<TagDetector> crop_detector;
   const TagCornerRefiner full_range_refiner{PixelFormat::GREY};
   const TagCornerRefiner limited_range_refiner{PixelFormat::YUYV};
   std::unordered_map<int, std::array<Vec3, 4>> world_corners_by_id;
@@ -79,10 +89,26 @@ struct TagTracker::Impl {
   std::unordered_map<int, size_t> correspondence_by_id;
 
   std::optional<SE3> previous_pose;  // set only while the previous frame was tracked
+  // The last two measured poses at their frames' mid-exposure (older first), and the frames since
+  // the newer one; prediction needs both.
+  std::optional<TimedPose> measured_older, measured_newer;
+  int frames_since_measured = 0;
   bool warned_size_mismatch = false;
   bool nothing_virtual = false;
 
   void track(FrameContext& ctx);
+  void forget_motion() {
+    previous_pose.reset();
+    measured_older.reset();
+    measured_newer.reset();
+    frames_since_measured = 0;
+  }
+  // Turns detections into correspondences of the bundle (refining their corners) and appends them
+  // to ctx.pose.tags.
+  void collect(FrameContext& ctx, const uint8_t* pixels, size_t stride);
+  // Runs the crop detector on the predicted tags' box grown by a margin; fills `detections` in
+  // full-frame pixels.
+  void search_near(const FrameContext& ctx, const SE3& predicted, const uint8_t* pixels, size_t stride);
   // Returns a skip reason, or empty when the frame can be tracked.
   std::string why_not_trackable(const FrameContext& ctx);
 };
@@ -101,10 +127,19 @@ void TagTracker::configure(const Config& config) {
   // Only the virtual objects need the pose today (light probes and shadows will too): with nothing
   // to draw, tracking is work the scene does not need.
   impl_->nothing_virtual = !config.render.enabled || config.render.objects.empty();
+  // The search needs a prediction, so without one the second detector (and its decode table) is
+  // not built.
+  std::unique_ptr<TagDetector> crop_detector;
+  if (config.track.max_predicted_frames > 0) {
+    Config crop_config = config;
+    crop_config.track.quad_decimate = 1;
+    crop_detector = std::make_unique<TagDetector>(crop_config);
+  }
+  impl_->crop_detector = std::move(crop_detector);
   impl_->detector = std::move(detector);
   impl_->world_corners_by_id = std::move(world_corners_by_id);
   // A new bundle may define a different world frame, so the old pose says nothing.
-  impl_->previous_pose.reset();
+  impl_->forget_motion();
   impl_->warned_size_mismatch = false;
 }
 
@@ -125,19 +160,10 @@ std::string TagTracker::Impl::why_not_trackable(const FrameContext& ctx) {
   return {};
 }
 
-void TagTracker::Impl::track(FrameContext& ctx) {
+void TagTracker::Impl::collect(FrameContext& ctx, const uint8_t* pixels, size_t stride) {
   const Frame& frame = ctx.camera;
-  const uint8_t* pixels = frame.data.data();
-  size_t stride = frame.bytes_per_line;
-  if (frame.format != PixelFormat::GREY) {
-    to_grey(frame, grey);
-    pixels = grey.data();
-    stride = static_cast<size_t>(frame.width);
-  }
-  detector->detect(pixels, frame.width, frame.height, stride, detections);
   const bool limited_range = frame.format == PixelFormat::YUYV || frame.format == PixelFormat::NV12;
   const TagCornerRefiner& refiner = limited_range ? limited_range_refiner : full_range_refiner;
-
   // One correspondence per bundle id; if a tag shows up twice (a reflection), the surer one counts.
   correspondences.clear();
   correspondence_margins.clear();
@@ -163,13 +189,102 @@ void TagTracker::Impl::track(FrameContext& ctx) {
       correspondence_margins[slot->second] = observation.decision_margin;
     }
   }
+}
 
-  const auto solution = correspondences.empty()
-                            ? std::nullopt
-                            : solve_tag_pose(*ctx.camera_model, correspondences, config.ambiguity_ratio, previous_pose);
+void TagTracker::Impl::search_near(const FrameContext& ctx, const SE3& predicted, const uint8_t* pixels,
+                                   size_t stride) {
+  detections.clear();
+  const Frame& frame = ctx.camera;
+  double x0 = 1e18, y0 = 1e18, x1 = -1e18, y1 = -1e18;
+  for (const auto& [id, corners] : world_corners_by_id) {
+    for (const Vec3& corner : corners) {
+      const auto pixel = ctx.camera_model->project(predicted * corner);
+      if (!pixel) return;  // behind the camera or off the lens: nothing sensible to search
+      x0 = std::min(x0, (*pixel)[0]);
+      y0 = std::min(y0, (*pixel)[1]);
+      x1 = std::max(x1, (*pixel)[0]);
+      y1 = std::max(y1, (*pixel)[1]);
+    }
+  }
+  // The margin covers the prediction's error and the blur's smear: half the box again each side,
+  // and at least 40 px (the fastest pans of configs/sim/tag-pan.toml smear 20-30 px).
+  const double margin = std::max(40.0, 0.5 * std::max(x1 - x0, y1 - y0));
+  const int left = std::clamp(int(std::floor(x0 - margin)), 0, frame.width);
+  const int top = std::clamp(int(std::floor(y0 - margin)), 0, frame.height);
+  const int right = std::clamp(int(std::ceil(x1 + margin)), 0, frame.width);
+  const int bottom = std::clamp(int(std::ceil(y1 + margin)), 0, frame.height);
+  if (right - left < 16 || bottom - top < 16) return;
+  crop_detector->detect(pixels + size_t(top) * stride + size_t(left), right - left, bottom - top, stride, detections);
+  for (TagObservation& observation : detections) {
+    for (Vec2& corner : observation.corners) {
+      corner[0] += left;
+      corner[1] += top;
+    }
+  }
+}
+
+void TagTracker::Impl::track(FrameContext& ctx) {
+  const Frame& frame = ctx.camera;
+  const uint8_t* pixels = frame.data.data();
+  size_t stride = frame.bytes_per_line;
+  if (frame.format != PixelFormat::GREY) {
+    to_grey(frame, grey);
+    pixels = grey.data();
+    stride = static_cast<size_t>(frame.width);
+  }
+  const int64_t time_ns = frame.meta.exposure_mid_ns();
+  // Dropped frames count: the prediction reaches that much further. (Capped so it cannot overflow.)
+  frames_since_measured = std::min(frames_since_measured + 1 + int(std::min<uint64_t>(ctx.dropped_before, 1000)),
+                                   1'000'000);
+
+  // The constant-velocity prediction for this frame, while the last measurement is recent enough.
+  std::optional<SE3> predicted;
+  if (config.max_predicted_frames > 0 && measured_older && measured_newer &&
+      frames_since_measured <= config.max_predicted_frames && measured_newer->time_ns != measured_older->time_ns &&
+      time_ns > measured_newer->time_ns) {
+    predicted = pose_at_time(*measured_older, *measured_newer, time_ns);
+  }
+
+  detector->detect(pixels, frame.width, frame.height, stride, detections);
+  collect(ctx, pixels, stride);
+  auto solution = correspondences.empty()
+                      ? std::nullopt
+                      : solve_tag_pose(*ctx.camera_model, correspondences, config.ambiguity_ratio, previous_pose);
+  bool searched = false;
+  if (!solution && predicted && crop_detector) {
+    // Search near the prediction: a blurred tag the full-frame pass missed.
+    searched = true;
+    search_near(ctx, *predicted, pixels, stride);
+    collect(ctx, pixels, stride);
+    if (!correspondences.empty()) {
+      solution = solve_tag_pose(*ctx.camera_model, correspondences, config.ambiguity_ratio, predicted);
+    }
+  }
+  if (!solution && predicted) {
+    // The uncertainty model: the displacement extrapolated since the last measurement, that is the
+    // error if the camera had stopped at it. It grows linearly with the frames predicted, needs no
+    // history beyond the two poses, and is what a renderer can compare with a threshold. It is not
+    // a bound: a reversal costs more (2.5-3.3x on tag-pan, where the pan turns and speeds up).
+    ctx.pose.state = TrackState::Predicted;
+    ctx.pose.T_cam_world = *predicted;
+    ctx.pose.frames_since_measured = frames_since_measured;
+    ctx.pose.predicted_uncertainty_deg =
+        rotation_angle_between(*predicted, measured_newer->T_cam_world) * 180.0 / std::numbers::pi;
+    ctx.pose.predicted_uncertainty_mm =
+        1e3 * norm(predicted->inverse().translation() - measured_newer->T_cam_world.inverse().translation());
+    previous_pose.reset();
+    log::debug("track: frame {}: predicted, {} frames since measured (+-{:.2f} deg, {:.1f} mm)", ctx.input_index,
+               frames_since_measured, ctx.pose.predicted_uncertainty_deg, ctx.pose.predicted_uncertainty_mm);
+    return;
+  }
   if (!solution) {
     ctx.pose.state = TrackState::Lost;
     previous_pose.reset();
+    // Once the prediction has run out, the old motion says nothing about the next acquisition.
+    if (frames_since_measured > config.max_predicted_frames) {
+      measured_older.reset();
+      measured_newer.reset();
+    }
     log::debug("track: frame {}: lost ({} detections, {} of the bundle)", ctx.input_index, detections.size(),
                correspondences.size());
     return;
@@ -180,8 +295,16 @@ void TagTracker::Impl::track(FrameContext& ctx) {
   ctx.pose.ambiguous = solution->ambiguous;
   ctx.pose.tags_used = solution->tags_used;
   previous_pose = solution->T_cam_world;
-  log::debug("track: frame {}: {} tags, rms {:.3f} px{}", ctx.input_index, solution->tags_used,
-             solution->reprojection_rms_px, solution->ambiguous ? ", ambiguous" : "");
+  if (measured_newer && time_ns > measured_newer->time_ns) {
+    measured_older = measured_newer;
+  } else {
+    measured_older.reset();  // times out of order: no velocity from these two
+  }
+  measured_newer = TimedPose{time_ns, solution->T_cam_world};
+  frames_since_measured = 0;
+  log::debug("track: frame {}: {} tags, rms {:.3f} px{}{}", ctx.input_index, solution->tags_used,
+             solution->reprojection_rms_px, solution->ambiguous ? ", ambiguous" : "",
+             searched ? ", found near the prediction" : "");
 }
 
 void TagTracker::process(FrameContext& ctx) noexcept {
@@ -193,14 +316,14 @@ void TagTracker::process(FrameContext& ctx) noexcept {
     if (skipped.empty()) {
       impl_->track(ctx);
     } else {
-      impl_->previous_pose.reset();
+      impl_->forget_motion();
     }
   } catch (const std::exception& e) {
     // Only allocation or conversion failures get here; one frame without a pose is the right outcome.
     log::debug("track: frame {}: {}", ctx.input_index, e.what());
     ctx.pose = PoseEstimate{};
     ctx.pose.state = TrackState::Lost;
-    impl_->previous_pose.reset();
+    impl_->forget_motion();
   }
   const double ms = milliseconds_since(start);
   try {

@@ -67,7 +67,7 @@ TEST(Config, DefaultTomlReadsBackAsTheDefaultConfigAndListsEveryKey) {
   for (const char* line :
        {"[source]", "type = ", "path = ", "pacing = ", "loop = ", "timestamp_offset_ns = ", "camera_model = ",
         "[track]", "enabled = ", "family = ", "quad_decimate = ", "quad_sigma = ", "threads = ", "max_hamming = ",
-        "min_decision_margin = ", "ambiguity_ratio = ", "[[track.bundle]]", "id = ", "size_m = ", "center_m = ",
+        "min_decision_margin = ", "ambiguity_ratio = ", "max_predicted_frames = ", "[[track.bundle]]", "id = ", "size_m = ", "center_m = ",
         "yaw_deg = ", "[motion]", "latency_frames = ", "default_exposure_ms = ", "[render]", "light_direction = ", "light_color = ", "ambient = ", "msaa_samples = ",
         "egl_platform = ", "lens = ", "lens_canvas_scale = ", "[[render.objects]]", "mesh = ", "position_m = ",
         "scale = ", "color = ", "[sinks.png]", "dir = ", "every = ", "[sinks.y4m]", "[sinks.recording]",
@@ -94,6 +94,7 @@ threads = 2
 max_hamming = 2
 min_decision_margin = 35.5
 ambiguity_ratio = 4.0
+max_predicted_frames = 5
 
 [[track.bundle]]
 id = 7
@@ -160,6 +161,7 @@ log_level = "debug"
   EXPECT_EQ(c.track.max_hamming, 2);
   EXPECT_EQ(c.track.min_decision_margin, 35.5);
   EXPECT_EQ(c.track.ambiguity_ratio, 4.0);
+  EXPECT_EQ(c.track.max_predicted_frames, 5);
   ASSERT_EQ(c.track.bundle.size(), 2u);
   EXPECT_EQ(c.track.bundle[0].id, 7);
   EXPECT_EQ(c.track.bundle[0].size_m, 0.05);
@@ -268,6 +270,10 @@ TEST(Config, OutOfRangeValuesSayWhatWasExpected) {
   expect_error("[track]\nfamily = \"tag36h12\"\n",
                {"test.toml:2:10:", "'track.family' expected one of", "tagCircle49h12", "tag36h10", "got \"tag36h12\""});
   expect_error("[track]\nthreads = 0\n", {"'track.threads' expected an integer in [1, 64], got 0"});
+  expect_error("[track]\nmax_predicted_frames = 31\n",
+               {"'track.max_predicted_frames' expected an integer in [0, 30], got 31"});
+  expect_error("[track]\nmax_predicted_frames = -1\n",
+               {"'track.max_predicted_frames' expected an integer in [0, 30], got -1"});
   expect_error("[track]\nmax_hamming = 4\n", {"'track.max_hamming' expected an integer in [0, 3], got 4"});
   expect_error("[track]\nquad_decimate = 0.5\n", {"'track.quad_decimate' expected a number >= 1, got 0.5"});
   expect_error("[track]\nambiguity_ratio = 0.9\n", {"'track.ambiguity_ratio' expected a number >= 1"});

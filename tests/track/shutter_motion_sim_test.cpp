@@ -24,6 +24,7 @@
 #include "capture/sim/simulator.h"
 #include "core/motion/motion_stage.h"
 #include "core/track/tag_tracker.h"
+#include "tests/track/simulated_capture.h"
 
 namespace arpipe {
 namespace {
@@ -34,29 +35,7 @@ constexpr double kDegreesPerRadian = 180.0 / std::numbers::pi;
 double angle_deg(const SE3& a, const SE3& b) { return rotation_angle_between(a, b) * kDegreesPerRadian; }
 double centre_mm(const SE3& a, const SE3& b) { return 1e3 * norm(a.inverse().translation() - b.inverse().translation()); }
 
-// A scene simulated into a scratch directory under the build tree; removed afterwards.
-class SimulatedCapture {
- public:
-  SimulatedCapture(const std::string& scene_file, int samples_per_pixel, int frames = 0)
-      : dir_(fs::path(ARPIPE_BINARY_DIR) / "test-scratch" / "motion" /
-             fmt::format("{}-{}", fs::path(scene_file).stem().string(), getpid())) {
-    fs::remove_all(dir_);
-    fs::create_directories(dir_.parent_path());
-    scene_ = sim::load_sim_scene(fs::path(ARPIPE_SOURCE_DIR) / "configs" / "sim" / scene_file);
-    scene_.render.samples_per_pixel = samples_per_pixel;
-    sim::SimulateOptions options;
-    options.out_dir = dir_;
-    options.frames = frames;
-    sim::simulate(scene_, options);
-  }
-  ~SimulatedCapture() { fs::remove_all(dir_); }
-  const fs::path& dir() const { return dir_; }
-  const sim::SimScene& scene() const { return scene_; }
-
- private:
-  fs::path dir_;
-  sim::SimScene scene_;
-};
+using test::SimulatedCapture;
 
 struct Summary {
   std::vector<double> values;

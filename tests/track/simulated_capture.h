@@ -1,0 +1,44 @@
+// Test helper for the track tests: a scene from configs/sim simulated into a scratch directory
+// under the build tree (at a chosen sample count and frame count), removed afterwards.
+#pragma once
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <string>
+
+#include <fmt/format.h>
+
+#include "capture/sim/sim_scene_loader.h"
+#include "capture/sim/simulator.h"
+
+namespace arpipe::test {
+
+class SimulatedCapture {
+ public:
+  // frames = 0: the scene's own frame count. `scratch` names the folder under test-scratch/.
+  SimulatedCapture(const std::string& scene_file, int samples_per_pixel, int frames = 0,
+                   const std::string& scratch = "motion")
+      : dir_(std::filesystem::path(ARPIPE_BINARY_DIR) / "test-scratch" / scratch /
+             fmt::format("{}-{}", std::filesystem::path(scene_file).stem().string(), getpid())) {
+    std::filesystem::remove_all(dir_);
+    std::filesystem::create_directories(dir_.parent_path());
+    scene_ = sim::load_sim_scene(std::filesystem::path(ARPIPE_SOURCE_DIR) / "configs" / "sim" / scene_file);
+    scene_.render.samples_per_pixel = samples_per_pixel;
+    sim::SimulateOptions options;
+    options.out_dir = dir_;
+    options.frames = frames;
+    sim::simulate(scene_, options);
+  }
+  ~SimulatedCapture() { std::filesystem::remove_all(dir_); }
+  SimulatedCapture(const SimulatedCapture&) = delete;
+  SimulatedCapture& operator=(const SimulatedCapture&) = delete;
+  const std::filesystem::path& dir() const { return dir_; }
+  const sim::SimScene& scene() const { return scene_; }
+
+ private:
+  std::filesystem::path dir_;
+  sim::SimScene scene_;
+};
+
+}  // namespace arpipe::test
