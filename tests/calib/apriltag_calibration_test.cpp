@@ -35,21 +35,7 @@ std::string grid_scene(const CalibrationBoard& board) {
   };
   set("samples_per_pixel", "9");
   set("frames", "30");
-  text += R"(
-[[object]]
-name = "table"
-position = [0.0, 0.0, -0.0005]
-width_m = 2.0
-height_m = 2.0
-albedo = [0.35, 0.30, 0.25]
-
-[[light]]
-direction = [0.3, -0.4, 1.0]
-irradiance = 4.0
-
-[environment]
-radiance = [0.30, 0.30, 0.33]
-)";
+  text += kTableLightAndSky;
   const double pitch = board.spacing_m;
   for (int r = 0; r < board.rows; ++r)
     for (int c = 0; c < board.cols; ++c)

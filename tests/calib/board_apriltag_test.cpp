@@ -87,18 +87,8 @@ time_s = 1.0
 position = [0.21, 0.0, 0.26]
 look_at = [0.21, 0.0, 0.0]
 up = [0.0, 1.0, 0.0]
-[[object]]
-name = "table"
-position = [0.0, 0.0, -0.0005]
-width_m = 2.0
-height_m = 2.0
-albedo = [0.35, 0.30, 0.25]
-[[light]]
-direction = [0.3, -0.4, 1.0]
-irradiance = 4.0
-[environment]
-radiance = [0.30, 0.30, 0.33]
 )";
+  text += kTableLightAndSky;
   for (int r = 0; r < kRows; ++r)
     for (int c = 0; c < kCols; ++c) {
       const int index = r * kCols + c;

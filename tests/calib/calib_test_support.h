@@ -33,6 +33,24 @@ inline std::vector<Vec3> calib_capture_corners() {
   return out;
 }
 
+// The calib scenes' surroundings in scene-file text: a table under the board, the key light and
+// the sky, as configs/sim/calib-board.toml has them.
+inline constexpr const char* kTableLightAndSky = R"(
+[[object]]
+name = "table"
+position = [0.0, 0.0, -0.0005]
+width_m = 2.0
+height_m = 2.0
+albedo = [0.35, 0.30, 0.25]
+
+[[light]]
+direction = [0.3, -0.4, 1.0]
+irradiance = 4.0
+
+[environment]
+radiance = [0.30, 0.30, 0.33]
+)";
+
 // An empty scratch directory for one test, in the build tree.
 inline fs::path scratch_dir(const std::string& name) {
   const fs::path dir =

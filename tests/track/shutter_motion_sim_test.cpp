@@ -30,10 +30,8 @@ namespace arpipe {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr double kDegreesPerRadian = 180.0 / std::numbers::pi;
-
-double angle_deg(const SE3& a, const SE3& b) { return rotation_angle_between(a, b) * kDegreesPerRadian; }
-double centre_mm(const SE3& a, const SE3& b) { return 1e3 * norm(a.inverse().translation() - b.inverse().translation()); }
+using test::angle_deg;
+using test::centre_mm;
 
 using test::SimulatedCapture;
 

@@ -1,18 +1,28 @@
-// Test helper for the track tests: a scene from configs/sim simulated into a scratch directory
-// under the build tree (at a chosen sample count and frame count), removed afterwards.
+// Test helpers for the track tests: a scene from configs/sim simulated into a scratch directory
+// under the build tree (at a chosen sample count and frame count), removed afterwards; and the two
+// pose errors the simulator comparisons report.
 #pragma once
 
 #include <unistd.h>
 
 #include <filesystem>
+#include <numbers>
 #include <string>
 
 #include <fmt/format.h>
 
 #include "capture/sim/sim_scene_loader.h"
 #include "capture/sim/simulator.h"
+#include "core/geometry/se3.h"
 
 namespace arpipe::test {
+
+// The rotation between two camera poses, in degrees, and the distance between their camera centres,
+// in mm.
+inline double angle_deg(const SE3& a, const SE3& b) { return rotation_angle_between(a, b) * 180.0 / std::numbers::pi; }
+inline double centre_mm(const SE3& a, const SE3& b) {
+  return 1e3 * norm(a.inverse().translation() - b.inverse().translation());
+}
 
 class SimulatedCapture {
  public:
