@@ -111,6 +111,7 @@ size_t PipelineRunner::first_stage_with_latency() const {
 }
 
 void PipelineRunner::finish_frame(FrameContext& ctx, size_t first_stage) {
+  if (busy_since_ns_ == 0) busy_since_ns_ = monotonic_now_ns();  // a held frame at the end of the stream
   for (size_t i = first_stage; i < stages_.size(); ++i) stages_[i]->process(ctx);
   {
     std::lock_guard lock(metrics_mutex_);
@@ -124,6 +125,9 @@ void PipelineRunner::finish_frame(FrameContext& ctx, size_t first_stage) {
     if (ctx.pose.state == TrackState::Predicted) ++metrics_.frames_predicted;
     if (ctx.pose.state == TrackState::Lost) ++metrics_.frames_lost;
   }
+  // Not busy once the stages are done: a push that waits for a slow sink is the sink's stall, and
+  // the sink may take the frame before this thread runs again.
+  busy_since_ns_ = 0;
   to_sink_->push(std::move(ctx));
 }
 
