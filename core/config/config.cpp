@@ -312,7 +312,7 @@ void read_render(const ConfigReader& r, const toml::table& t, RenderConfig& out)
   const std::string p = "render.";
   r.check_keys(t, p,
                {"enabled", "objects", "light_direction", "light_color", "ambient", "msaa_samples", "egl_platform",
-                "lens", "lens_canvas_scale"},
+                "lens", "lens_canvas_scale", "rolling_shutter", "blur"},
                "[render]");
   r.read(t, p, "enabled", out.enabled);
   if (const toml::array* objects = r.array_of_tables(t, p, "objects")) {
@@ -345,6 +345,16 @@ void read_render(const ConfigReader& r, const toml::table& t, RenderConfig& out)
   r.read(t, p, "lens", out.lens, {"map", "vertex", "undistort"});
   r.read(t, p, "lens_canvas_scale", out.lens_canvas_scale, [](double v) { return v >= 1 && v <= 4; },
          "a number in [1, 4]");
+  r.read(t, p, "rolling_shutter", out.rolling_shutter);
+  if (const toml::table* blur = r.table(t, p, "blur")) {
+    const std::string bp = "render.blur.";
+    r.check_keys(*blur, bp, {"method", "samples", "min_motion_px"}, "[render.blur]");
+    r.read(*blur, bp, "method", out.blur.method, {"off", "accumulate", "seed", "velocity"});
+    // 1024: far beyond what converges (bench blur's reference uses 256); the seed method caps at 50.
+    r.read(*blur, bp, "samples", out.blur.samples, 0, 1024);
+    r.read(*blur, bp, "min_motion_px", out.blur.min_motion_px, [](double v) { return v >= 0 && v <= 1000; },
+           "a number in [0, 1000] (pixels)");
+  }
 }
 
 void read_sinks(const ConfigReader& r, const toml::table& t, SinksConfig& out) {
@@ -601,6 +611,13 @@ std::string default_config_toml() {
   entry("lens", s(d.render.lens), "\"map\", \"vertex\" or \"undistort\"");
   entry("lens_canvas_scale", f(d.render.lens_canvas_scale),
         "\"map\": canvas pixels per core pixel, [1, 4]; finer edges, cost grows with its square");
+  entry("rolling_shutter", b(d.render.rolling_shutter),
+        "draw each row with its own exposure's pose when the readout time is non-zero");
+  out += "\n[render.blur]                  # motion blur of the virtual layer over each exposure\n";
+  entry("method", s(d.render.blur.method),
+        "\"off\", \"accumulate\" (N renders: the reference), \"seed\" (2 renders + affine warps), \"velocity\" (fastest)");
+  entry("samples", fmt::format("{}", d.render.blur.samples), "0..1024; 0: from the frame's image motion");
+  entry("min_motion_px", f(d.render.blur.min_motion_px), "frames with less image motion are drawn sharp");
   out += "\n# Virtual objects: one [[render.objects]] each, placed in the world (anchor) frame.\n";
   for (const SceneObject& object : d.render.objects) {
     out += "[[render.objects]]\n";

@@ -84,6 +84,21 @@ struct SceneObject {
   bool operator==(const SceneObject&) const = default;
 };
 
+// Motion blur of the virtual layer (docs/ARCHITECTURE.md, "Motion blur"): how the virtual objects
+// are smeared over each exposure to match the camera's own blur.
+struct BlurConfig {
+  // "off"; "accumulate": full renders spread over the exposure, averaged (the reference);
+  // "seed": seed 000, two renders at 1/4 and 3/4 plus affine-warped samples between them;
+  // "velocity": one render plus a per-pixel velocity gather (fastest).
+  std::string method = "seed";
+  // Samples per frame; 0 chooses them from the frame's image motion (seed: the thesis's rule).
+  int samples = 0;
+  // Below this much image motion over the exposure a frame is drawn sharp, at no extra cost.
+  double min_motion_px = 0.5;
+
+  bool operator==(const BlurConfig&) const = default;
+};
+
 struct RenderConfig {
   bool enabled = true;
   std::vector<SceneObject> objects{SceneObject{}};
@@ -104,6 +119,10 @@ struct RenderConfig {
   // straight edge up to 1/8 canvas pixel off; a finer canvas divides that, at its square in fill
   // and memory (tests/render/lens_matched_rendering_test.cpp measures both).
   double lens_canvas_scale = 1.5;
+  // With a rolling shutter (non-zero readout time and a motion estimate) draw each vertex with the
+  // pose of its own row's exposure, so the virtual layer skews like the picture.
+  bool rolling_shutter = true;
+  BlurConfig blur;
 
   bool operator==(const RenderConfig&) const = default;
 };

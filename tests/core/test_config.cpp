@@ -69,7 +69,8 @@ TEST(Config, DefaultTomlReadsBackAsTheDefaultConfigAndListsEveryKey) {
         "[track]", "enabled = ", "family = ", "quad_decimate = ", "quad_sigma = ", "threads = ", "max_hamming = ",
         "min_decision_margin = ", "ambiguity_ratio = ", "max_predicted_frames = ", "[[track.bundle]]", "id = ", "size_m = ", "center_m = ",
         "yaw_deg = ", "[motion]", "latency_frames = ", "default_exposure_ms = ", "[render]", "light_direction = ", "light_color = ", "ambient = ", "msaa_samples = ",
-        "egl_platform = ", "lens = ", "lens_canvas_scale = ", "[[render.objects]]", "mesh = ", "position_m = ",
+        "egl_platform = ", "lens = ", "lens_canvas_scale = ", "rolling_shutter = ", "[render.blur]", "method = ", "samples = ",
+        "min_motion_px = ", "[[render.objects]]", "mesh = ", "position_m = ",
         "scale = ", "color = ", "[sinks.png]", "dir = ", "every = ", "[sinks.y4m]", "[sinks.recording]",
         "[sinks.results]", "[pipeline]", "queue_depth = ", "max_frames = ", "log_level = "})
     EXPECT_NE(text.find(std::string("\n") + line), std::string::npos) << line;
@@ -425,6 +426,36 @@ TEST(Config, BadOverridesAreErrorsNamingTheOverride) {
   expect_error("", {"override 'render.lens=warp'", "'render.lens' expected one of \"map\", \"vertex\", \"undistort\"",
                     "got \"warp\""},
                {"render.lens=warp"});
+}
+
+}  // namespace
+}  // namespace arpipe
+
+namespace arpipe {
+namespace {
+
+TEST(Config, BlurKeysHaveTheirDefaultsAndReadBack) {
+  const Config d;
+  EXPECT_EQ(d.render.blur.method, "seed");
+  EXPECT_EQ(d.render.blur.samples, 0);
+  EXPECT_EQ(d.render.blur.min_motion_px, 0.5);
+  EXPECT_TRUE(d.render.rolling_shutter);
+  const Config c = parse_config(
+      "[render]\nrolling_shutter = false\n[render.blur]\nmethod = \"velocity\"\nsamples = 16\nmin_motion_px = 2\n", "b.toml");
+  EXPECT_FALSE(c.render.rolling_shutter);
+  EXPECT_EQ(c.render.blur.method, "velocity");
+  EXPECT_EQ(c.render.blur.samples, 16);
+  EXPECT_EQ(c.render.blur.min_motion_px, 2.0);
+  EXPECT_EQ(parse_config("", "b.toml", {"render.blur.method=accumulate"}).render.blur.method, "accumulate");
+}
+
+TEST(Config, BlurValuesOutOfRangeAreRefusedNamingFileAndKey) {
+  expect_error("[render.blur]\nmethod = \"fast\"\n",
+               {"test.toml:2:", "'render.blur.method' expected one of \"off\", \"accumulate\", \"seed\", \"velocity\""});
+  expect_error("[render.blur]\nsamples = -1\n", {"test.toml:2:", "'render.blur.samples'", "got -1"});
+  expect_error("[render.blur]\nsamples = 2000\n", {"'render.blur.samples'", "got 2000"});
+  expect_error("[render.blur]\nmin_motion_px = -0.5\n", {"'render.blur.min_motion_px'", "got -0.5"});
+  expect_error("[render.blur]\nwidth = 3\n", {"unknown key 'render.blur.width'"});
 }
 
 }  // namespace
