@@ -24,6 +24,7 @@ struct ReplaySource::Impl {
   RecordingReader reader;
   std::shared_ptr<const CameraModel> model;
   int64_t loop_period_ns = 0;   // added to timestamps per completed pass
+  std::optional<int64_t> frame_interval_ns;
   uint64_t loop_sequences = 0;  // added to sequence numbers per completed pass
   size_t next_index = 0;
   uint64_t passes = 0;
@@ -62,6 +63,7 @@ ReplaySource::ReplaySource(const SourceConfig& config) : impl_(std::make_unique<
     const FrameMetadata& last = s.reader.metadata(count - 1);
     int64_t interval = last.frame_duration_ns;
     if (interval <= 0 && count > 1) interval = (last.exposure_start_ns - first.exposure_start_ns) / int64_t(count - 1);
+    if (interval > 0) s.frame_interval_ns = interval;
     if (interval <= 0) interval = kFallbackFrameIntervalNs;
     s.loop_period_ns = std::max<int64_t>(last.exposure_start_ns - first.exposure_start_ns, 0) + interval;
     s.loop_sequences = last.sequence >= first.sequence ? last.sequence - first.sequence + 1 : count;
@@ -69,6 +71,8 @@ ReplaySource::ReplaySource(const SourceConfig& config) : impl_(std::make_unique<
 }
 
 ReplaySource::~ReplaySource() = default;
+
+std::optional<int64_t> ReplaySource::frame_interval_ns() const { return impl_->frame_interval_ns; }
 
 std::string ReplaySource::describe() const {
   const Impl& s = *impl_;

@@ -26,6 +26,9 @@ class ReplaySource : public FrameSource {
   // sequence numbers), so time and sequence never go backwards. A frame that fails its checksum
   // is logged, counted and skipped (Retry); an interrupt() during a pacing sleep returns Retry
   // and the frame comes with the next call.
+  // The recording's frame duration, else the mean spacing of its frames; nullopt for fewer than two
+  // frames without a duration.
+  std::optional<int64_t> frame_interval_ns() const override;
   SourceStatus next(Frame& frame) override;
   void interrupt() override;
 

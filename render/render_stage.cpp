@@ -19,52 +19,9 @@
 namespace arpipe {
 namespace {
 
-constexpr std::string_view kVertexShader = R"glsl(
-layout(location = 0) in vec3 a_position;
-layout(location = 1) in vec3 a_normal;
-uniform mat3 u_cam_from_object_linear;  // rotation times scale
-uniform vec3 u_cam_from_object_translation;
-uniform mat3 u_world_from_object_rotation;
-out vec3 v_normal_world;
-
-void main() {
-  gl_Position = camera_to_clip(u_cam_from_object_linear * a_position + u_cam_from_object_translation);
-  v_normal_world = u_world_from_object_rotation * a_normal;
-}
-)glsl";
-
-constexpr std::string_view kFragmentShader = R"glsl(#version 300 es
-precision highp float;
-in vec3 v_normal_world;
-uniform vec4 u_base_color;       // linear, straight alpha
-uniform vec3 u_light_direction;  // world frame, unit, towards the light
-uniform vec3 u_light_color;
-uniform vec3 u_ambient;
-out vec4 out_color;              // linear, premultiplied alpha
-
-void main() {
-  vec3 normal = normalize(v_normal_world);
-  if (!gl_FrontFacing) normal = -normal;  // the inside of an open mesh faces the other way
-  float lambert = max(dot(normal, u_light_direction), 0.0);
-  vec3 rgb = u_base_color.rgb * (u_ambient + u_light_color * lambert);
-  out_color = vec4(rgb * u_base_color.a, u_base_color.a);
-}
-)glsl";
-
 // Covers the multisampled edge pixels and the bend of distorted edges between sampled points.
 constexpr double kRectMarginPx = 2.0;
-
-// Column-major, as glUniformMatrix3fv wants it without transposing.
-std::array<float, 9> column_major(const Mat3& m, double scale) {
-  std::array<float, 9> out{};
-  for (size_t col = 0; col < 3; ++col)
-    for (size_t row = 0; row < 3; ++row) out[col * 3 + row] = static_cast<float>(m[row][col] * scale);
-  return out;
-}
-
-void set_vec3(GLint location, const Vec3& v) {
-  glUniform3f(location, static_cast<float>(v[0]), static_cast<float>(v[1]), static_cast<float>(v[2]));
-}
+constexpr int kExposureInstants = 8;  // pieces of the exposure whose ends bound the footprint
 
 }  // namespace
 
@@ -74,16 +31,14 @@ RenderStage::~RenderStage() {
   session_->try_make_current();
   objects_.clear();
   warp_pass_.reset();
-  program_ = GlProgram();
+  drawer_.reset();
 }
 
 void RenderStage::configure(const Config& config) {
   session_->ensure_context(config.render.egl_platform);
   session_->make_current();
-  if (program_.id() == 0)
-    program_ = GlProgram("object shading",
-                         fmt::format("#version 300 es\nprecision highp float;\n{}\n{}", lens_projection_glsl(), kVertexShader),
-                         kFragmentShader);
+  if (!drawer_) drawer_ = std::make_unique<MotionBlurDrawer>(session_->context(), session_->layer().color_format());
+  drawer_->prepare(parse_blur_method(config.render.blur.method));
   std::vector<RenderObject> objects = load_render_objects(config);
 
   Settings settings;
@@ -95,6 +50,8 @@ void RenderStage::configure(const Config& config) {
   settings.ambient = config.render.ambient;
   settings.lens = parse_lens_mode(config.render.lens);
   settings.lens_canvas_scale = config.render.lens_canvas_scale;
+  settings.rolling_shutter = config.render.rolling_shutter;
+  settings.blur = config.render.blur;
 
   // The warp's shader is compiled here rather than on the first frame that needs it.
   if (settings.lens == LensMode::Map && !warp_pass_)
@@ -136,7 +93,9 @@ void RenderStage::process(FrameContext& ctx) noexcept {
     std::string skip;
     if (!settings_.enabled) skip = "render disabled";
     else if (objects_.empty()) skip = "no objects";
-    else if (ctx.pose.state != TrackState::Tracking) skip = fmt::format("pose {}", track_state_name(ctx.pose.state));
+    // A predicted pose is drawn too: detection fails exactly on the strongly blurred frames
+    // that need the blur most.
+    else if (ctx.pose.state != TrackState::Tracking && ctx.pose.state != TrackState::Predicted) skip = fmt::format("pose {}", track_state_name(ctx.pose.state));
     if (!skip.empty()) {
       ctx.record_timing(std::string(name()), milliseconds_since(start), std::move(skip));
       return;
@@ -172,21 +131,29 @@ void RenderStage::draw(FrameContext& ctx) {
       settings_.lens == LensMode::Undistort ? pinhole_core(ctx.camera_model) : nullptr;
   const CameraModel& image_camera = core ? *core : camera;
 
-  struct Visible {
-    const RenderObject* object;
-    SE3 T_cam_object;
-  };
-  std::vector<Visible> visible;
+  // The rectangle the objects can reach over the exposure (blurred, or skewed by a rolling
+  // shutter): their boxes at 9 instants from its start to its end, so that a path whose ends lie
+  // outside the picture still counts where it crosses it (the margin covers the bend between).
+  std::vector<SE3> exposure_poses{ctx.pose.T_cam_world};
+  if (ctx.motion.valid()) {
+    const int64_t start = ctx.motion.timing.exposure_start_ns, span = ctx.motion.timing.end_ns() - start;
+    for (int k = 0; k <= kExposureInstants; ++k)
+      exposure_poses.push_back(ctx.motion.T_cam_world_at(start + span * k / kExposureInstants));
+  }
+  LayerDrawRequest request;
   PixelRect rect;  // in the output image
   for (const RenderObject& object : objects_) {
-    const SE3 T_cam_object = ctx.pose.T_cam_world * object.T_world_object;
-    if (std::optional<PixelRect> object_rect =
-            projected_box_rect(image_camera, T_cam_object, object.bounds, kRectMarginPx)) {
-      rect = rect.united(*object_rect);
-      visible.push_back({&object, T_cam_object});
+    bool in_view = false;
+    for (const SE3& T_cam_world : exposure_poses) {
+      if (std::optional<PixelRect> object_rect =
+              projected_box_rect(image_camera, T_cam_world * object.T_world_object, object.bounds, kRectMarginPx)) {
+        rect = rect.united(*object_rect);
+        in_view = true;
+      }
     }
+    if (in_view) request.objects.push_back(&object);
   }
-  if (visible.empty()) return;
+  if (request.objects.empty()) return;
 
   // "map": draw on the pinhole canvas, in the part of it that the output rectangle samples.
   std::shared_ptr<const LensWarpMap> warp;
@@ -194,47 +161,27 @@ void RenderStage::draw(FrameContext& ctx) {
     warp = warp_map(ctx.camera_model);
     if (warp->identity()) warp.reset();  // a pinhole lens: the canvas is the image
   }
-  const LensUniforms lens = warp ? lens_uniforms(warp->canvas().model()) : lens_uniforms(image_camera);
-  const PixelRect draw_rect = warp ? warp->canvas_rect_for(rect) : rect;
+  const CameraModel& canvas_camera = warp ? warp->canvas().model() : image_camera;
+  request.motion = &ctx.motion;
+  request.T_cam_world = ctx.pose.T_cam_world;
+  request.lens = lens_uniforms(canvas_camera);
+  request.canvas_camera = &canvas_camera;
+  request.rows = {camera.fy(), camera.cy(), camera.height()};
+  request.lighting = {settings_.light_direction, settings_.light_color, settings_.ambient};
+  request.rect = warp ? warp->canvas_rect_for(rect) : rect;
+  request.image_motion_px = ctx.motion.valid() ? ctx.motion.max_image_motion_px : 0;
+  request.msaa_samples = settings_.msaa_samples;
+  request.rolling_shutter = settings_.rolling_shutter;
 
   session_->make_current();
   VirtualLayer& layer = session_->layer();
-  layer.ensure(lens.width, lens.height, settings_.msaa_samples);
-  layer.begin(draw_rect);
-  glEnable(GL_DEPTH_TEST);
-  glDepthFunc(GL_LESS);
-  glDisable(GL_BLEND);
-  glDisable(GL_CULL_FACE);
-  // Image rows run down GL's y axis (lens_projection.h), which mirrors the winding: a triangle
-  // counter-clockwise seen from outside is clockwise in window coordinates.
-  glFrontFace(GL_CW);
-
-  set_lens_uniforms(program_, lens);  // binds the program
-  set_vec3(program_.uniform("u_light_direction"), settings_.light_direction);
-  set_vec3(program_.uniform("u_light_color"), settings_.light_color);
-  set_vec3(program_.uniform("u_ambient"), settings_.ambient);
-  const GLint cam_from_object_linear = program_.uniform("u_cam_from_object_linear");
-  const GLint cam_from_object_translation = program_.uniform("u_cam_from_object_translation");
-  const GLint world_from_object_rotation = program_.uniform("u_world_from_object_rotation");
-  const GLint base_color = program_.uniform("u_base_color");
-  for (const Visible& item : visible) {
-    const std::array<float, 9> linear = column_major(item.T_cam_object.rotation(), item.object->scale);
-    const std::array<float, 9> rotation = column_major(item.object->T_world_object.rotation(), 1.0);
-    glUniformMatrix3fv(cam_from_object_linear, 1, GL_FALSE, linear.data());
-    set_vec3(cam_from_object_translation, item.T_cam_object.translation());
-    glUniformMatrix3fv(world_from_object_rotation, 1, GL_FALSE, rotation.data());
-    item.object->mesh->draw([&](const MeshPart& part) {
-      const std::array<float, 4>& color = item.object->base_color ? *item.object->base_color : part.base_color;
-      glUniform4f(base_color, color[0], color[1], color[2], color[3]);
-    });
-  }
-  layer.resolve(draw_rect);
+  const LayerDrawResult drawn = drawer_->draw(layer, request, settings_.blur);
   glDisable(GL_SCISSOR_TEST);
-  GLuint drawn_texture = layer.texture();
+  GLuint drawn_texture = drawn.texture;
   if (warp) {
     if (!warp_pass_) warp_pass_ = std::make_unique<LensWarpPass>(layer.color_format());
     warp_pass_->set_map(warp);
-    warp_pass_->run(layer.texture(), rect);
+    warp_pass_->run(drawn_texture, rect);
     drawn_texture = warp_pass_->texture();
   }
   // The work is queued until something waits for it; waiting here keeps the stage timings honest.
@@ -242,6 +189,8 @@ void RenderStage::draw(FrameContext& ctx) {
   check_gl("drawing the virtual layer");
   session_->drawn = {drawn_texture, camera.width(), camera.height(), rect};
   ctx.virtual_layer_drawn = true;
+  ctx.blur_method = std::string(blur_method_name(drawn.method));
+  ctx.blur_samples = drawn.samples;
 }
 
 }  // namespace arpipe

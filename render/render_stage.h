@@ -8,10 +8,10 @@
 #include <vector>
 
 #include "core/pipeline/stage.h"
-#include "render/gl_program.h"
 #include "render/lens_mode.h"
 #include "render/lens_warp_map.h"
 #include "render/lens_warp_pass.h"
+#include "render/motion_blur.h"
 #include "render/per_model_cache.h"
 #include "render/render_objects.h"
 #include "render/render_session.h"
@@ -32,8 +32,8 @@ class RenderStage final : public Stage {
   // builds its own on its first drawn frame.
   void prepare(const std::shared_ptr<const CameraModel>& camera_model) noexcept override;
   // Skips (ctx.virtual_layer_drawn = false, reason recorded) when rendering is off, there are no
-  // objects, the pose is not Tracking, or no object's box reaches into the image; such frames do
-  // no GL work.
+  // objects, there is no pose (neither Tracking nor Predicted), or no object's box reaches into the
+  // image; such frames do no GL work. Blurs by render.blur when the frame's motion asks for it.
   void process(FrameContext& ctx) noexcept override;
 
  private:
@@ -45,13 +45,15 @@ class RenderStage final : public Stage {
     Vec3 ambient{0, 0, 0};
     LensMode lens = LensMode::Map;
     double lens_canvas_scale = 1.5;
+    bool rolling_shutter = true;
+    BlurConfig blur;
   };
   void draw(FrameContext& ctx);
   std::shared_ptr<const LensWarpMap> warp_map(const std::shared_ptr<const CameraModel>& camera_model);
   std::shared_ptr<const CameraModel> pinhole_core(const std::shared_ptr<const CameraModel>& camera_model);
 
   std::shared_ptr<RenderSession> session_;  // first member: outlives the GL objects below
-  GlProgram program_;
+  std::unique_ptr<MotionBlurDrawer> drawer_;  // the objects' programs and the blur passes
   std::unique_ptr<LensWarpPass> warp_pass_;  // made by configure with render.lens = "map"
   PerModelCache<LensWarpMap> warp_maps_;
   PerModelCache<CameraModel> pinhole_cores_;  // render.lens = "undistort": what the output sees

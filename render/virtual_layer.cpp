@@ -56,17 +56,24 @@ void VirtualLayer::ensure(int width, int height, int msaa_samples) {
   height_ = height;
   requested_samples_ = msaa_samples;
   samples_ = samples;
+  resolved_written_ = PixelRect::full(width, height);
 }
 
 void VirtualLayer::begin(const PixelRect& rect) {
+  const GLfloat transparent[4] = {0, 0, 0, 0};
+  glEnable(GL_SCISSOR_TEST);
+  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  if (!resolved_written_.empty() && !(resolved_written_ == rect)) {
+    glBindFramebuffer(GL_FRAMEBUFFER, resolved_framebuffer_.get());
+    glScissor(resolved_written_.x, resolved_written_.y, resolved_written_.width, resolved_written_.height);
+    glClearBufferfv(GL_COLOR, 0, transparent);
+  }
+  resolved_written_ = rect;
   glBindFramebuffer(GL_FRAMEBUFFER, draw_framebuffer_.get());
   glViewport(0, 0, width_, height_);
-  glEnable(GL_SCISSOR_TEST);
   // GL rows are image rows (see lens_projection.h), so the rectangle needs no flip.
   glScissor(rect.x, rect.y, rect.width, rect.height);
   glDepthMask(GL_TRUE);
-  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-  const GLfloat transparent[4] = {0, 0, 0, 0};
   glClearBufferfv(GL_COLOR, 0, transparent);
   const GLfloat far_depth = 1.0f;
   glClearBufferfv(GL_DEPTH, 0, &far_depth);

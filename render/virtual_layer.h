@@ -18,12 +18,15 @@ class VirtualLayer {
   // a count above what the format supports is lowered to that (with a warning).
   void ensure(int width, int height, int msaa_samples);
   // Binds the framebuffer to draw into with viewport = whole image, scissor = rect (left enabled),
-  // and clears the rect to transparent black and far depth.
+  // and clears the rect to transparent black and far depth. What earlier frames resolved outside
+  // rect is cleared too, so texture() is transparent everywhere but rect (the blur passes sample
+  // beyond it).
   void begin(const PixelRect& rect);
   // Makes what was drawn inside rect available in texture().
   void resolve(const PixelRect& rect);
 
   GLuint texture() const { return resolved_texture_.get(); }
+  GLuint resolved_framebuffer() const { return resolved_framebuffer_.get(); }  // texture()'s
   GLenum color_format() const { return color_format_; }
   int samples() const { return samples_; }  // 1 when not multisampled
   int width() const { return width_; }
@@ -40,7 +43,8 @@ class VirtualLayer {
   GlFramebuffer resolved_framebuffer_;
   GlRenderbuffer multisample_color_;
   GlRenderbuffer depth_;
-  GlFramebuffer draw_framebuffer_;  // the multisampled one, or resolved_framebuffer_'s twin with depth
+  GlFramebuffer draw_framebuffer_;
+  PixelRect resolved_written_;  // what texture() may hold: all of it after allocation  // the multisampled one, or resolved_framebuffer_'s twin with depth
 };
 
 }  // namespace arpipe

@@ -14,6 +14,8 @@ int run_replay(const Args& args);    // arpipe replay DIR [--config FILE] [--set
 int run_simulate(const Args& args);  // arpipe simulate --scene FILE --out DIR [--frames N] [--seed S] ...
 int run_config(const Args& args);    // arpipe config --defaults | --check FILE
 int run_board(const Args& args);     // arpipe board FILE --out BOARD.png [--dpi N]
-int run_calib(const Args& args);     // arpipe calib (--images GLOB | --recording DIR) --board FILE --out FILE ...
+int run_calib(const Args& args);
+int run_bench(const Args& args);       // arpipe bench blur [...]
+int run_bench_blur(const Args& args);  // arpipe bench blur [--capture DIR | --scene FILE] [--out DIR] ...     // arpipe calib (--images GLOB | --recording DIR) --board FILE --out FILE ...
 
 }  // namespace arpipe

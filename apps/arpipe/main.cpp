@@ -21,6 +21,9 @@ commands:
                                      board (configs/boards/), with a report
   board FILE --out BOARD.png [--dpi N]
                                      draw a board file's printable picture
+  bench blur [--capture DIR | --scene FILE] [--out DIR] [--frames N] [--reference-samples N]
+                                     motion-blur methods: time against error (PSNR, SSIM)
+                                     vs the converged reference and the simulator's truth
   config --defaults                  print a config with every key at its default
   config --check FILE                validate a config file
 )";
@@ -41,6 +44,7 @@ int main(int argc, char** argv) {
   if (command == "config") return arpipe::run_config(args);
   if (command == "calib") return arpipe::run_calib(args);
   if (command == "board") return arpipe::run_board(args);
+  if (command == "bench") return arpipe::run_bench(args);
   std::fprintf(stderr, "arpipe: unknown command '%s'\n%s", command.c_str(), kUsage);
   return 2;
 }

@@ -63,6 +63,15 @@ std::unique_ptr<PipelineRunner> assemble_pipeline(const Config& config) {
                                     lens_mode_name(lens)));
     }
   }
+  // An exposure longer than the frame interval cannot happen; the configured fallback exposure
+  // must be possible for this source.
+  const std::optional<int64_t> interval = source->frame_interval_ns();
+  if (config.track.enabled && config.motion.enabled && interval && config.motion.default_exposure_ns > *interval)
+    throw ConfigError(fmt::format(
+        "{}: motion.default_exposure_ms = {} is longer than the frame interval of {} ({} ms): an exposure cannot "
+        "outlast its frame",
+        config.file.empty() ? std::string("the config") : config.file.string(), double(config.motion.default_exposure_ns) * 1e-6,
+        source->describe(), double(*interval) * 1e-6));
   auto sinks = make_sinks(config);
   return std::make_unique<PipelineRunner>(std::move(source), make_stage_factory(config), std::move(sinks), config);
 }

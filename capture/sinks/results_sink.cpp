@@ -24,7 +24,12 @@ std::string ResultsSink::to_json_line(const FrameContext& ctx) {
   j["exposure_start_ns"] = ctx.camera.meta.exposure_start_ns;
   j["dropped_before"] = ctx.dropped_before;
   j["track_state"] = std::string(track_state_name(ctx.pose.state));
-  if (ctx.pose.state == TrackState::Tracking) {
+  if (ctx.pose.state == TrackState::Predicted) {
+    j["frames_since_measured"] = ctx.pose.frames_since_measured;
+    j["predicted_uncertainty_deg"] = ctx.pose.predicted_uncertainty_deg;
+    j["predicted_uncertainty_mm"] = ctx.pose.predicted_uncertainty_mm;
+  }
+  if (ctx.pose.state == TrackState::Tracking || ctx.pose.state == TrackState::Predicted) {
     const Vec3 r = ctx.pose.T_cam_world.rotation_vector();
     const Vec3& t = ctx.pose.T_cam_world.translation();
     j["T_cam_world"] = {{"r", {r[0], r[1], r[2]}}, {"t", {t[0], t[1], t[2]}}};
@@ -39,7 +44,17 @@ std::string ResultsSink::to_json_line(const FrameContext& ctx) {
         j["anchor_px"] = {(*px)[0], (*px)[1]};
     }
   }
+  json motion = {{"state", std::string(motion_state_name(ctx.motion.state))}};
+  if (ctx.motion.valid()) {
+    motion["image_motion_px"] = ctx.motion.max_image_motion_px;
+    motion["exposure_ns"] = ctx.motion.timing.exposure_ns;
+    motion["fallback_exposure"] = ctx.motion.fallback_exposure;
+  } else if (!ctx.motion.why_none.empty()) {
+    motion["why_none"] = std::string(ctx.motion.why_none);
+  }
+  j["motion"] = motion;
   j["virtual_layer_drawn"] = ctx.virtual_layer_drawn;
+  if (ctx.virtual_layer_drawn) j["blur"] = {{"method", ctx.blur_method}, {"samples", ctx.blur_samples}};
   json timings = json::object();
   json skips = json::object();
   for (const auto& t : ctx.timings) {

@@ -76,17 +76,18 @@ std::string MotionStage::Impl::estimate(FrameContext& ctx) {
   if (!configured) return "not configured";
   if (!config.enabled) return "disabled";
   if (!tracking_on) return "tracking disabled";
-  if (ctx.pose.state != TrackState::Tracking) {
-    // A predicted pose is the tracker's own extrapolation: no measurement to derive motion from.
-    motion.why_none = ctx.pose.state == TrackState::Lost        ? "no pose: tracking lost"
-                      : ctx.pose.state == TrackState::Predicted ? "no measured pose: the pose is predicted"
-                                                                : "no pose: tracking did not run";
+  if (ctx.pose.state != TrackState::Tracking && ctx.pose.state != TrackState::Predicted) {
+    motion.why_none = ctx.pose.state == TrackState::Lost ? "no pose: tracking lost" : "no pose: tracking did not run";
     return std::string(motion.why_none);
   }
-  observe(ctx);
-  const TimedPose* current = track.find(ctx.input_index);
-  if (!current) return "no pose";  // not reached: observe() just added it
+  // A predicted pose is the tracker's constant-velocity extrapolation: it has motion (the frames it
+  // stands in for are the blurred ones), but it stays out of the track, which holds measurements.
+  const bool predicted = ctx.pose.state == TrackState::Predicted;
+  if (!predicted) observe(ctx);
   const ShutterTiming t = timing(ctx);
+  const TimedPose predicted_pose{tracked_pose_time_ns(t, ctx.pose, bundle), ctx.pose.T_cam_world};
+  const TimedPose* current = predicted ? &predicted_pose : track.find(ctx.input_index);
+  if (!current) return "no pose";  // not reached: observe() just added it
   if (t.fallback_exposure && ctx.camera.meta.frame_duration_ns > 0 &&
       config.default_exposure_ns > ctx.camera.meta.frame_duration_ns && !warned_exposure_cap) {
     log::warn("motion: motion.default_exposure_ms = {} is longer than the frame interval ({} ms); using the interval",
@@ -95,8 +96,8 @@ std::string MotionStage::Impl::estimate(FrameContext& ctx) {
   }
   // With latency 1 the runner has shown this stage the next frame already (look_ahead); it has no
   // pose at the end of the stream or when tracking lost it, and the end is then extrapolated.
-  const TimedPose* next = config.latency_frames >= 1 ? track.next(ctx.input_index) : nullptr;
-  motion = estimate_shutter_motion(t, *current, track.previous(ctx.input_index), next);
+  const TimedPose* next = config.latency_frames >= 1 ? track.after(ctx.input_index, current->time_ns) : nullptr;
+  motion = estimate_shutter_motion(t, *current, track.before(ctx.input_index, current->time_ns), next);
   if (!motion.valid()) return std::string(motion.why_none);
   if (ctx.camera_model) motion.max_image_motion_px = max_image_motion_px(motion, *ctx.camera_model, reference_points);
   return {};

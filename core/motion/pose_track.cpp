@@ -36,19 +36,25 @@ const TimedPose* PoseTrack::find(uint64_t frame) const {
 
 const TimedPose* PoseTrack::previous(uint64_t frame) const {
   const Entry* self = entry(frame);
-  if (!self) return nullptr;
-  const Entry* best = nullptr;
-  for (const Entry& e : entries_)
-    if (e.frame < frame) best = &e;
-  if (!best || self->pose.time_ns - best->pose.time_ns > max_gap_ns_) return nullptr;
-  return &best->pose;
+  return self ? before(frame, self->pose.time_ns) : nullptr;
 }
 
 const TimedPose* PoseTrack::next(uint64_t frame) const {
   const Entry* self = entry(frame);
-  if (!self) return nullptr;
+  return self ? after(frame, self->pose.time_ns) : nullptr;
+}
+
+const TimedPose* PoseTrack::before(uint64_t frame, int64_t time_ns) const {
+  const Entry* best = nullptr;
   for (const Entry& e : entries_)
-    if (e.frame > frame) return e.pose.time_ns - self->pose.time_ns > max_gap_ns_ ? nullptr : &e.pose;
+    if (e.frame < frame) best = &e;
+  if (!best || time_ns - best->pose.time_ns > max_gap_ns_) return nullptr;
+  return &best->pose;
+}
+
+const TimedPose* PoseTrack::after(uint64_t frame, int64_t time_ns) const {
+  for (const Entry& e : entries_)
+    if (e.frame > frame) return e.pose.time_ns - time_ns > max_gap_ns_ ? nullptr : &e.pose;
   return nullptr;
 }
 

@@ -35,6 +35,9 @@ class PoseTrack {
   // The nearest tracked frame before / after `frame` within max_gap_ns of its pose; nullptr if none.
   const TimedPose* previous(uint64_t frame) const;
   const TimedPose* next(uint64_t frame) const;
+  // The same for a frame that is not in the track (a predicted pose at time_ns).
+  const TimedPose* before(uint64_t frame, int64_t time_ns) const;
+  const TimedPose* after(uint64_t frame, int64_t time_ns) const;
   size_t size() const { return entries_.size(); }
 
  private:

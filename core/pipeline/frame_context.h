@@ -62,6 +62,9 @@ struct FrameContext {
   // is "undistort" (the output is then an undistorted picture). Set with ctx.output.
   std::shared_ptr<const CameraModel> output_camera_model;
   bool virtual_layer_drawn = false;
+  // How the virtual layer was drawn: "off" (sharp) or the render.blur method used, and its samples.
+  std::string blur_method = "off";
+  int blur_samples = 0;
   std::vector<StageTiming> timings;
   uint64_t input_index = 0;                     // position in the stream as the pipeline saw it
   uint64_t dropped_before = 0;                  // frames lost just before this one (sequence gap or queue drop)

@@ -20,6 +20,9 @@ class FrameSource {
   virtual bool is_live() const = 0;
   // The camera model the frames were taken with (a recording carries its own).
   virtual std::shared_ptr<const CameraModel> camera_model() const = 0;
+  // The time from one frame's start to the next's, when the source knows it (a recording's frame
+  // duration or spacing, a live camera's negotiated rate): no exposure can be longer.
+  virtual std::optional<int64_t> frame_interval_ns() const { return std::nullopt; }
   // Blocks until the next frame (paced as configured). Never throws for a per-frame problem:
   // returns Retry after logging (camera gone, timeout) or EndOfStream at the end of a recording.
   virtual SourceStatus next(Frame& frame) = 0;

@@ -280,6 +280,38 @@ TEST(MotionStage, LatencyZeroExtrapolatesAndSaysWhyWhenItCannot) {
             1e-12);
 }
 
+TEST(MotionStage, APredictedPoseGetsMotionButStaysOutOfTheTrack) {
+  // The tracker's prediction lies on the constant-velocity path of the last measurements, so the
+  // motion over its exposure follows that path; the next measured frame must still interpolate
+  // between measurements only.
+  const auto model = std::make_shared<CameraModel>(CameraModel::pinhole(500, 500, 319.5, 239.5, 640, 480));
+  const SteadyCamera camera;
+  MotionStage stage;
+  stage.configure(Config{});
+  for (uint64_t frame : {0u, 1u}) {
+    FrameContext ctx = tracked_frame(frame, camera, 8'000'000, model);
+    stage.process(ctx);
+  }
+  FrameContext predicted = tracked_frame(2, camera, 8'000'000, model);
+  predicted.pose.state = TrackState::Predicted;
+  stage.process(predicted);
+  ASSERT_EQ(predicted.motion.state, MotionState::Extrapolated);
+  // SteadyCamera moves at constant velocity: exact to rounding.
+  EXPECT_LT(angle_between(predicted.motion.T_cam_world_start, camera.T_cam_world(predicted.motion.timing.exposure_start_ns)),
+            1e-9);
+  EXPECT_LT(angle_between(predicted.motion.T_cam_world_end, camera.T_cam_world(predicted.motion.timing.end_ns())), 1e-9);
+  EXPECT_GT(predicted.motion.max_image_motion_px, 5.0);
+
+  // Frame 3 is measured: its previous neighbour is frame 1, the last measurement, not the prediction.
+  FrameContext after = tracked_frame(3, camera, 8'000'000, model);
+  after.pose.T_cam_world = SE3(rotation_from_vector({0, 0.01, 0}), {0, 0, 0}) * after.pose.T_cam_world;
+  stage.process(after);
+  ASSERT_EQ(after.motion.state, MotionState::Extrapolated);
+  FrameContext again = tracked_frame(4, camera, 8'000'000, model);
+  stage.process(again);
+  EXPECT_EQ(again.motion.state, MotionState::Extrapolated);
+}
+
 TEST(MotionStage, LatencyOneInterpolatesWhenShownTheNextFrame) {
   const auto model = std::make_shared<CameraModel>(CameraModel::pinhole(500, 500, 319.5, 239.5, 640, 480));
   const SteadyCamera camera;

@@ -109,6 +109,41 @@ TEST_F(ArpipeCli, SimulateThenReplay) {
   EXPECT_EQ(tracking, 3u);
 }
 
+TEST_F(ArpipeCli, ReplayRefusesAFallbackExposureLongerThanTheFrameInterval) {
+  // The default capture runs at 30 fps: no exposure can last 50 ms. Refused before any frame, with
+  // the file, the key and the source's interval; nothing is written.
+  std::ofstream(dir_ / "long.toml") << "[motion]\ndefault_exposure_ms = 50\n[sinks.results]\npath = \""
+                                    << (dir_ / "r.jsonl").string() << "\"\n";
+  std::string err;
+  EXPECT_EQ(run({"replay", kCapture.string(), "--config", (dir_ / "long.toml").string()}, nullptr, &err), 2);
+  EXPECT_NE(err.find("long.toml"), std::string::npos) << err;
+  EXPECT_NE(err.find("motion.default_exposure_ms = 50"), std::string::npos) << err;
+  EXPECT_NE(err.find("frame interval"), std::string::npos) << err;
+  EXPECT_NE(err.find("33.3"), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(dir_ / "r.jsonl"));
+  // 30 ms fits.
+  std::ofstream(dir_ / "ok.toml") << "[motion]\ndefault_exposure_ms = 30\n[sinks.results]\npath = \""
+                                  << (dir_ / "r.jsonl").string() << "\"\n[sinks.png]\nenabled = false\n[sinks.y4m]\nenabled = false\n";
+  EXPECT_EQ(run({"replay", kCapture.string(), "--config", (dir_ / "ok.toml").string()}, nullptr, &err), 0) << err;
+}
+
+TEST_F(ArpipeCli, BenchBlurPrintsItsTableOnAShortCapture) {
+  // A 6-frame blur-bench capture at 1 sample per pixel and a 16-render reference: the command runs
+  // end to end and prints a row per method; the numbers themselves are the bench's, not a test's.
+  const fs::path capture = dir_ / "capture";
+  const fs::path scene = fs::path(ARPIPE_SOURCE_DIR) / "configs" / "sim" / "blur-bench.toml";
+  std::string out, err;
+  ASSERT_EQ(run({"simulate", "--scene", scene.string(), "--out", capture.string(), "--frames", "6", "--samples", "1"},
+                nullptr, &err),
+            0)
+      << err;
+  ASSERT_EQ(run({"bench", "blur", "--capture", capture.string(), "--reference-samples", "16"}, &out, &err), 0) << err;
+  for (const char* row : {"| accumulate 16 (reference) |", "| off auto |", "| seed auto |", "| velocity auto |"})
+    EXPECT_NE(out.find(row), std::string::npos) << row << "\n" << out;
+  EXPECT_EQ(run({"bench", "blur", "--capture", (dir_ / "missing").string()}, nullptr, &err), 1);
+  EXPECT_NE(err.find("missing"), std::string::npos) << err;
+}
+
 TEST_F(ArpipeCli, SimulateNamesTheBadSceneFileAndKey) {
   std::ofstream(dir_ / "bad.toml") << "[camera]\nexposure_ms = 0\n";
   std::string err;

@@ -1,0 +1,342 @@
+// arpipe bench blur: run time against error of the motion-blur methods on a simulated pan
+// (configs/sim/blur-bench.toml): each method and sample count against the converged "accumulate"
+// reference (PSNR and SSIM over the object's footprint), and the whole pipeline's output against
+// the simulator's ray-traced, physically blurred picture of the same virtual object.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <limits>
+#include <mutex>
+#include <numbers>
+#include <numeric>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "apps/arpipe/commands.h"
+#include "apps/arpipe/progress_bar.h"
+#include "apps/common/pipeline_assembly.h"
+#include "capture/recording/recording_reader.h"
+#include "capture/sim/sim_scene_loader.h"
+#include "capture/sim/simulator.h"
+#include "core/image/image_quality.h"
+#include "core/image/pixel_convert.h"
+#include "core/log.h"
+#include "render/render_stages.h"
+
+namespace arpipe {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* kUsage =
+    "usage: arpipe bench blur [--capture DIR | --scene FILE] [--out DIR] [--frames N] [--reference-samples N]\n"
+    "                         [--config FILE] [--set KEY=VALUE]...\n"
+    "  --capture DIR   a recording with ground_truth_composite/ (default: simulate --scene into --out)\n"
+    "  --scene FILE    simulator scene (default configs/sim/blur-bench.toml)\n"
+    "  --out DIR       where the simulated capture goes (default out/bench-blur; reused when present)\n"
+    "  --frames N      simulate only the first N frames\n"
+    "  --reference-samples N   renders of the accumulate reference (default 256)\n"
+    "  --config FILE   pipeline config for the objects, light and lens (default: configs/arpipe.toml's cube)\n";
+
+struct Variant {
+  std::string method;
+  int samples = 0;  // 0: from the motion
+  std::string label() const { return samples > 0 ? fmt::format("{} {}", method, samples) : method + " auto"; }
+};
+
+// Keeps what tracking and motion found for each frame (pass 1), to draw it again per variant.
+class KeepContexts : public FrameSink {
+ public:
+  std::string describe() const override { return "bench: keep frames"; }
+  void consume(const FrameContext& ctx) noexcept override {
+    std::lock_guard lock(mutex_);
+    frames.push_back(ctx);
+  }
+  std::mutex mutex_;
+  std::vector<FrameContext> frames;
+};
+
+struct Rendered {
+  std::vector<uint8_t> rgb;  // the composite, empty when not drawn
+  double render_ms = 0;
+  std::string blur_method;
+  int blur_samples = 0;
+};
+
+std::vector<Rendered> draw_all(const Config& base, const Variant& variant, const std::vector<FrameContext>& frames) {
+  Config config = base;
+  config.render.blur.method = variant.method;
+  config.render.blur.samples = variant.samples;
+  std::vector<std::unique_ptr<Stage>> stages = make_render_stages();
+  for (auto& stage : stages) stage->configure(config);
+  if (!frames.empty())
+    for (auto& stage : stages) stage->prepare(frames.front().camera_model);
+  std::vector<Rendered> out(frames.size());
+  for (size_t i = 0; i < frames.size(); ++i) {
+    FrameContext ctx;
+    ctx.camera = frames[i].camera;
+    ctx.camera_model = frames[i].camera_model;
+    ctx.pose = frames[i].pose;
+    ctx.motion = frames[i].motion;
+    ctx.input_index = frames[i].input_index;
+    for (auto& stage : stages) stage->process(ctx);
+    Rendered& r = out[i];
+    if (ctx.virtual_layer_drawn) r.rgb = ctx.output.data;
+    for (const StageTiming& t : ctx.timings) {
+      if (t.stage == "render") r.render_ms = t.ms;
+      if (t.stage == "render" && !t.skipped.empty()) log::debug("frame {}: render: {}", ctx.input_index, t.skipped);
+    }
+    r.blur_method = ctx.blur_method;
+    r.blur_samples = ctx.blur_samples;
+  }
+  return out;
+}
+
+double median(std::vector<double> values) {
+  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::sort(values.begin(), values.end());
+  const size_t n = values.size();
+  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+// Pixels where a composite differs from the camera frame: where the virtual layer drew something.
+std::vector<uint8_t> drawn_mask(const std::vector<uint8_t>& composite, const std::vector<uint8_t>& background) {
+  std::vector<uint8_t> mask(composite.size() / 3, 0);
+  for (size_t i = 0; i < mask.size(); ++i)
+    mask[i] = composite[3 * i] != background[3 * i] || composite[3 * i + 1] != background[3 * i + 1] ||
+              composite[3 * i + 2] != background[3 * i + 2];
+  return mask;
+}
+
+struct Score {
+  double psnr_db = 0;
+  double ssim = 0;
+};
+
+// Pooled PSNR (one MSE over every masked pixel of every frame) and the mean of the frames' SSIM.
+Score score(const std::vector<std::vector<uint8_t>>& got, const std::vector<std::vector<uint8_t>>& want,
+            const std::vector<std::vector<uint8_t>>& masks, int width, int height) {
+  double squared = 0, samples = 0, ssim_sum = 0;
+  int frames = 0;
+  for (size_t i = 0; i < got.size(); ++i) {
+    const RgbView a{got[i], width, height}, b{want[i], width, height};
+    const double psnr = masked_psnr(a, b, masks[i]);
+    if (std::isnan(psnr)) continue;
+    const double count = 3.0 * double(std::count(masks[i].begin(), masks[i].end(), uint8_t{1}));
+    if (std::isfinite(psnr)) squared += count * 255.0 * 255.0 / std::pow(10.0, psnr / 10);
+    samples += count;
+    ssim_sum += masked_ssim(a, b, masks[i]);
+    ++frames;
+  }
+  if (frames == 0) return {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
+  const double mse = squared / samples;
+  return {mse > 0 ? 10 * std::log10(255.0 * 255.0 / mse) : std::numeric_limits<double>::infinity(), ssim_sum / frames};
+}
+
+// The simulator's first directional light and constant sky, through its sensor (radiance x exposure
+// x sensitivity x gains, docs/SIMULATOR.md), as the renderer's light and ambient: what light
+// estimation will supply; without it the comparison with the simulator would measure the
+// difference in shading rather than in blur. The ambient is the sky seen by an upward face (the
+// renderer's ambient does not fall off on the sides as the simulator's sky does).
+void light_as_the_simulator(const sim::SimScene& scene, RenderConfig& render) {
+  const double scale = double(scene.camera.exposure_ns.front()) * 1e-9 * scene.camera.sensor.sensitivity *
+                       scene.camera.analogue_gain * scene.camera.digital_gain;
+  for (const sim::SimLight& light : scene.lights) {
+    if (light.kind != sim::SimLight::Kind::Directional) continue;
+    render.light_direction = light.direction_to_light;
+    for (size_t c = 0; c < 3; ++c) render.light_color[c] = scale * light.irradiance / std::numbers::pi * light.color[c];
+    break;
+  }
+  if (scene.environment.hdr_path.empty())
+    for (size_t c = 0; c < 3; ++c) render.ambient[c] = scale * scene.environment.radiance[c];
+}
+
+Config bench_config(const fs::path& config_path, const std::vector<std::string>& overrides, const fs::path& capture) {
+  std::vector<std::string> all = overrides;
+  Config config = config_path.empty() ? parse_config("", "arpipe bench blur", all) : load_config(config_path, all);
+  if (config_path.empty()) {
+    // configs/arpipe.toml's object, lit as the simulator lights the virtual cube (below).
+    config.render.objects = {SceneObject{}};
+    if (fs::exists(capture / "scene.toml")) light_as_the_simulator(sim::load_sim_scene(capture / "scene.toml"), config.render);
+  }
+  config.source.type = "replay";
+  config.source.path = capture;
+  config.source.pacing = "fast";
+  config.source.loop = false;
+  // Interpolated motion: the best estimate the pipeline can make (one frame of latency).
+  config.motion.latency_frames = 1;
+  config.sinks = SinksConfig{};
+  config.sinks.png.enabled = config.sinks.y4m.enabled = config.sinks.results.enabled = false;
+  config.sinks.recording.enabled = false;
+  return config;
+}
+
+}  // namespace
+
+int run_bench_blur(const Args& args) {
+  fs::path capture, scene_path = "configs/sim/blur-bench.toml", out_dir = "out/bench-blur", config_path;
+  int frames_limit = 0, reference_samples = 256;
+  std::vector<std::string> overrides;
+  for (size_t i = 0; i < args.size(); ++i) {
+    const std::string& key = args[i];
+    if (key == "--help" || key == "-h") {
+      std::fputs(kUsage, stdout);
+      return 0;
+    }
+    if (i + 1 >= args.size()) {
+      fmt::print(stderr, "arpipe bench blur: {} needs a value\n{}", key, kUsage);
+      return 2;
+    }
+    const std::string value = args[++i];
+    try {
+      if (key == "--capture") capture = value;
+      else if (key == "--scene") scene_path = value;
+      else if (key == "--out") out_dir = value;
+      else if (key == "--config") config_path = value;
+      else if (key == "--set") overrides.push_back(value);
+      else if (key == "--frames") frames_limit = std::stoi(value);
+      else if (key == "--reference-samples") reference_samples = std::stoi(value);
+      else {
+        fmt::print(stderr, "arpipe bench blur: unknown option {}\n{}", key, kUsage);
+        return 2;
+      }
+    } catch (const std::exception&) {
+      fmt::print(stderr, "arpipe bench blur: bad value '{}' for {}\n{}", value, key, kUsage);
+      return 2;
+    }
+  }
+  if (reference_samples < 2 || reference_samples > 1024 || frames_limit < 0) {
+    fmt::print(stderr, "arpipe bench blur: --reference-samples must be in [2, 1024] and --frames >= 0\n");
+    return 2;
+  }
+  try {
+    if (capture.empty()) {
+      capture = out_dir / "capture";
+      if (fs::exists(capture / "frames.jsonl")) {
+        log::info("reusing the capture in {} (delete it to simulate again)", capture.string());
+      } else {
+        sim::SimulateOptions options;
+        options.out_dir = capture;
+        options.frames = frames_limit;
+        ProgressBar progress("simulating");
+        options.on_frame = [&progress](int done, int total) { progress.update(done, total); };
+        const sim::SimulateSummary summary = sim::simulate(sim::load_sim_scene(scene_path), options);
+        progress.finish();
+        log::info("simulated {} frames of {} in {:.0f} s", summary.frames, scene_path.string(), summary.seconds);
+      }
+    }
+    const fs::path truth_dir = capture / "ground_truth_composite";
+    if (!fs::exists(truth_dir / "frames.jsonl"))
+      throw std::runtime_error(fmt::format("{}: no ground_truth_composite/ (the scene needs a virtual object)", capture.string()));
+
+    // Pass 1: tracking and motion, as the daemon runs them.
+    Config config = bench_config(config_path, overrides, capture);
+    Config track_only = config;
+    track_only.render.blur.method = "off";  // rendering stays on: tracking runs only for something to draw
+    auto keep = std::make_unique<KeepContexts>();
+    KeepContexts* kept = keep.get();
+    std::vector<std::unique_ptr<FrameSink>> sinks;
+    sinks.push_back(std::move(keep));
+    PipelineRunner runner(make_source(track_only), make_stage_factory(track_only), std::move(sinks), track_only);
+    runner.start();
+    runner.wait();
+    std::vector<FrameContext> frames = std::move(kept->frames);
+    std::sort(frames.begin(), frames.end(), [](const auto& a, const auto& b) { return a.input_index < b.input_index; });
+    int tracked = 0;
+    for (const FrameContext& f : frames) tracked += f.pose.state == TrackState::Tracking || f.pose.state == TrackState::Predicted;
+    log::info("tracking: {} of {} frames with a pose", tracked, frames.size());
+    if (frames.empty()) throw std::runtime_error(capture.string() + ": no frames");
+    const int width = frames.front().camera.width, height = frames.front().camera.height;
+
+    // The variants, the converged reference first.
+    std::vector<Variant> variants{{"accumulate", reference_samples}, {"off", 0}};
+    for (int n : {4, 8, 16, 32, 64}) variants.push_back({"accumulate", n});
+    variants.push_back({"accumulate", 0});
+    for (int n : {4, 8, 16, 32, 50}) variants.push_back({"seed", n});
+    variants.push_back({"seed", 0});
+    for (int n : {4, 8, 16, 32}) variants.push_back({"velocity", n});
+    variants.push_back({"velocity", 0});
+
+    std::vector<std::vector<Rendered>> results;
+    ProgressBar progress("variants");
+    for (size_t v = 0; v < variants.size(); ++v) {
+      results.push_back(draw_all(config, variants[v], frames));
+      progress.update(int(v + 1), int(variants.size()));
+    }
+    progress.finish();
+
+    // Which frames count: drawn by the reference with blur (moving) or sharp (still).
+    const RecordingReader truth(truth_dir);
+    std::vector<size_t> moving, still;
+    for (size_t i = 0; i < frames.size(); ++i) {
+      if (results[0][i].rgb.empty()) continue;
+      (results[0][i].blur_method == "off" ? still : moving).push_back(i);
+    }
+    std::vector<std::vector<uint8_t>> backgrounds(frames.size()), truths(frames.size());
+    std::vector<std::vector<uint8_t>> footprint(frames.size());
+    for (size_t i : moving) {
+      to_rgb24(frames[i].camera, backgrounds[i]);
+      Frame truth_frame;
+      truth.read(size_t(frames[i].input_index), truth_frame);
+      to_rgb24(truth_frame, truths[i]);
+      footprint[i] = dilate_mask(drawn_mask(results[0][i].rgb, backgrounds[i]), width, height, 2);
+    }
+
+    fmt::print("\n# arpipe bench blur: {} ({} frames: {} with motion >= {} px, {} still; reference: accumulate {})\n\n",
+               capture.string(), frames.size(), moving.size(), config.render.blur.min_motion_px, still.size(),
+               reference_samples);
+    fmt::print("| method | samples (median) | render ms/frame (median, moving) | time vs reference | PSNR dB vs reference | SSIM vs reference | PSNR dB vs simulator | SSIM vs simulator |\n");
+    fmt::print("|---|---|---|---|---|---|---|---|\n");
+    const double reference_ms = [&] {
+      std::vector<double> ms;
+      for (size_t i : moving) ms.push_back(results[0][i].render_ms);
+      return median(ms);
+    }();
+    for (size_t v = 0; v < variants.size(); ++v) {
+      std::vector<std::vector<uint8_t>> got, want, want_truth, masks;
+      std::vector<double> ms, samples;
+      for (size_t i : moving) {
+        const Rendered& r = results[v][i];
+        if (r.rgb.empty()) continue;
+        got.push_back(r.rgb);
+        want.push_back(results[0][i].rgb);
+        want_truth.push_back(truths[i]);
+        // The footprint of both: where either drew.
+        std::vector<uint8_t> mask = footprint[i];
+        const std::vector<uint8_t> mine = drawn_mask(r.rgb, backgrounds[i]);
+        for (size_t k = 0; k < mask.size(); ++k) mask[k] = mask[k] || mine[k];
+        masks.push_back(std::move(mask));
+        ms.push_back(r.render_ms);
+        samples.push_back(r.blur_samples);
+      }
+      const Score vs_reference = score(got, want, masks, width, height);
+      const Score vs_truth = score(got, want_truth, masks, width, height);
+      const double t = median(ms);
+      fmt::print("| {} | {:.0f} | {:.2f} | {:.3f} | {:.2f} | {:.4f} | {:.2f} | {:.4f} |\n",
+                 v == 0 ? variants[v].label() + " (reference)" : variants[v].label(), median(samples), t,
+                 t / reference_ms, vs_reference.psnr_db, vs_reference.ssim, vs_truth.psnr_db, vs_truth.ssim);
+    }
+    // Frames without motion: each method against the no-blur path, same frames, same run.
+    std::vector<double> off_ms;
+    for (size_t i : still) off_ms.push_back(results[1][i].render_ms);
+    fmt::print("\nStill frames (motion below {} px): render ms/frame, median over {} frames\n\n| method | ms | vs off |\n|---|---|---|\n",
+               config.render.blur.min_motion_px, still.size());
+    for (size_t v = 0; v < variants.size(); ++v) {
+      if (variants[v].samples != 0 && variants[v].method != "off") continue;
+      std::vector<double> ms;
+      for (size_t i : still) ms.push_back(results[v][i].render_ms);
+      fmt::print("| {} | {:.2f} | {:.2f} |\n", variants[v].label(), median(ms), median(ms) / median(off_ms));
+    }
+    return 0;
+  } catch (const std::exception& e) {
+    log::error("{}", e.what());
+    return 1;
+  }
+}
+
+}  // namespace arpipe
