@@ -68,32 +68,43 @@ struct Rendered {
   int blur_samples = 0;
 };
 
-std::vector<Rendered> draw_all(const Config& base, const Variant& variant, const std::vector<FrameContext>& frames) {
-  Config config = base;
-  config.render.blur.method = variant.method;
-  config.render.blur.samples = variant.samples;
-  std::vector<std::unique_ptr<Stage>> stages = make_render_stages();
-  for (auto& stage : stages) stage->configure(config);
-  if (!frames.empty())
-    for (auto& stage : stages) stage->prepare(frames.front().camera_model);
-  std::vector<Rendered> out(frames.size());
-  for (size_t i = 0; i < frames.size(); ++i) {
+// The render and composite stages configured for one variant, kept to draw frames again.
+class VariantRenderer {
+ public:
+  VariantRenderer(const Config& base, const Variant& variant, const std::shared_ptr<const CameraModel>& camera_model)
+      : stages_(make_render_stages()) {
+    Config config = base;
+    config.render.blur.method = variant.method;
+    config.render.blur.samples = variant.samples;
+    for (auto& stage : stages_) stage->configure(config);
+    for (auto& stage : stages_) stage->prepare(camera_model);
+  }
+
+  Rendered draw(const FrameContext& frame) {
     FrameContext ctx;
-    ctx.camera = frames[i].camera;
-    ctx.camera_model = frames[i].camera_model;
-    ctx.pose = frames[i].pose;
-    ctx.motion = frames[i].motion;
-    ctx.input_index = frames[i].input_index;
-    for (auto& stage : stages) stage->process(ctx);
-    Rendered& r = out[i];
-    if (ctx.virtual_layer_drawn) r.rgb = ctx.output.data;
-    for (const StageTiming& t : ctx.timings) {
+    ctx.camera = frame.camera;
+    ctx.camera_model = frame.camera_model;
+    ctx.pose = frame.pose;
+    ctx.motion = frame.motion;
+    ctx.input_index = frame.input_index;
+    for (auto& stage : stages_) stage->process(ctx);
+    Rendered r;
+    if (ctx.virtual_layer_drawn) r.rgb = std::move(ctx.output.data);
+    for (const StageTiming& t : ctx.timings)
       if (t.stage == "render") r.render_ms = t.ms;
-      if (t.stage == "render" && !t.skipped.empty()) log::debug("frame {}: render: {}", ctx.input_index, t.skipped);
-    }
     r.blur_method = ctx.blur_method;
     r.blur_samples = ctx.blur_samples;
+    return r;
   }
+
+ private:
+  std::vector<std::unique_ptr<Stage>> stages_;
+};
+
+std::vector<Rendered> draw_all(const Config& base, const Variant& variant, const std::vector<FrameContext>& frames) {
+  VariantRenderer renderer(base, variant, frames.front().camera_model);
+  std::vector<Rendered> out;
+  for (const FrameContext& frame : frames) out.push_back(renderer.draw(frame));
   return out;
 }
 
@@ -321,17 +332,22 @@ int run_bench_blur(const Args& args) {
                  v == 0 ? variants[v].label() + " (reference)" : variants[v].label(), median(samples), t,
                  t / reference_ms, vs_reference.psnr_db, vs_reference.ssim, vs_truth.psnr_db, vs_truth.ssim);
     }
-    // Frames without motion: each method against the no-blur path, same frames, same run.
-    std::vector<double> off_ms;
-    for (size_t i : still) off_ms.push_back(results[1][i].render_ms);
-    fmt::print("\nStill frames (motion below {} px): render ms/frame, median over {} frames\n\n| method | ms | vs off |\n|---|---|---|\n",
-               config.render.blur.min_motion_px, still.size());
-    for (size_t v = 0; v < variants.size(); ++v) {
-      if (variants[v].samples != 0 && variants[v].method != "off") continue;
-      std::vector<double> ms;
-      for (size_t i : still) ms.push_back(results[v][i].render_ms);
-      fmt::print("| {} | {:.2f} | {:.2f} |\n", variants[v].label(), median(ms), median(ms) / median(off_ms));
-    }
+    // Frames without motion: each method's default against the no-blur path on the same frames,
+    // interleaved and repeated, so that the comparison does not depend on when each ran.
+    constexpr int kStillRepeats = 30;
+    const std::vector<Variant> still_variants{{"off", 0}, {"accumulate", 0}, {"seed", 0}, {"velocity", 0}};
+    std::vector<VariantRenderer> renderers;
+    for (const Variant& variant : still_variants) renderers.emplace_back(config, variant, frames.front().camera_model);
+    std::vector<std::vector<double>> still_ms(still_variants.size());
+    for (int repeat = 0; repeat < kStillRepeats; ++repeat)
+      for (size_t v = 0; v < still_variants.size(); ++v)
+        for (size_t i : still) still_ms[v].push_back(renderers[v].draw(frames[i]).render_ms);
+    fmt::print("\nStill frames (motion below {} px): render ms/frame, median over {} frames x {} interleaved repeats\n\n"
+               "| method | ms | vs off |\n|---|---|---|\n",
+               config.render.blur.min_motion_px, still.size(), kStillRepeats);
+    for (size_t v = 0; v < still_variants.size(); ++v)
+      fmt::print("| {} | {:.2f} | {:.2f} |\n", still_variants[v].label(), median(still_ms[v]),
+                 median(still_ms[v]) / median(still_ms[0]));
     return 0;
   } catch (const std::exception& e) {
     log::error("{}", e.what());
