@@ -51,6 +51,7 @@ void RenderStage::configure(const Config& config) {
   settings.lens = parse_lens_mode(config.render.lens);
   settings.lens_canvas_scale = config.render.lens_canvas_scale;
   settings.rolling_shutter = config.render.rolling_shutter;
+  settings.max_predicted_uncertainty_deg = config.render.max_predicted_uncertainty_deg;
   settings.blur = config.render.blur;
 
   // The warp's shader is compiled here rather than on the first frame that needs it.
@@ -95,7 +96,12 @@ void RenderStage::process(FrameContext& ctx) noexcept {
     else if (objects_.empty()) skip = "no objects";
     // A predicted pose is drawn too: detection fails exactly on the strongly blurred frames
     // that need the blur most.
-    else if (ctx.pose.state != TrackState::Tracking && ctx.pose.state != TrackState::Predicted) skip = fmt::format("pose {}", track_state_name(ctx.pose.state));
+    else if (ctx.pose.state != TrackState::Tracking && ctx.pose.state != TrackState::Predicted)
+      skip = fmt::format("pose {}", track_state_name(ctx.pose.state));
+    else if (ctx.pose.state == TrackState::Predicted &&
+             ctx.pose.predicted_uncertainty_deg > settings_.max_predicted_uncertainty_deg)
+      skip = fmt::format("predicted pose too uncertain ({:.1f} > {:.1f} deg)", ctx.pose.predicted_uncertainty_deg,
+                         settings_.max_predicted_uncertainty_deg);
     if (!skip.empty()) {
       ctx.record_timing(std::string(name()), milliseconds_since(start), std::move(skip));
       return;

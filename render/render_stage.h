@@ -32,7 +32,8 @@ class RenderStage final : public Stage {
   // builds its own on its first drawn frame.
   void prepare(const std::shared_ptr<const CameraModel>& camera_model) noexcept override;
   // Skips (ctx.virtual_layer_drawn = false, reason recorded) when rendering is off, there are no
-  // objects, there is no pose (neither Tracking nor Predicted), or no object's box reaches into the
+  // objects, there is no pose (neither Tracking nor Predicted within
+  // render.max_predicted_uncertainty_deg), or no object's box reaches into the
   // image; such frames do no GL work. Blurs by render.blur when the frame's motion asks for it.
   void process(FrameContext& ctx) noexcept override;
 
@@ -46,6 +47,7 @@ class RenderStage final : public Stage {
     LensMode lens = LensMode::Map;
     double lens_canvas_scale = 1.5;
     bool rolling_shutter = true;
+    double max_predicted_uncertainty_deg = 5.0;
     BlurConfig blur;
   };
   void draw(FrameContext& ctx);

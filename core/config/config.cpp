@@ -312,7 +312,7 @@ void read_render(const ConfigReader& r, const toml::table& t, RenderConfig& out)
   const std::string p = "render.";
   r.check_keys(t, p,
                {"enabled", "objects", "light_direction", "light_color", "ambient", "msaa_samples", "egl_platform",
-                "lens", "lens_canvas_scale", "rolling_shutter", "blur"},
+                "lens", "lens_canvas_scale", "rolling_shutter", "max_predicted_uncertainty_deg", "blur"},
                "[render]");
   r.read(t, p, "enabled", out.enabled);
   if (const toml::array* objects = r.array_of_tables(t, p, "objects")) {
@@ -346,6 +346,8 @@ void read_render(const ConfigReader& r, const toml::table& t, RenderConfig& out)
   r.read(t, p, "lens_canvas_scale", out.lens_canvas_scale, [](double v) { return v >= 1 && v <= 4; },
          "a number in [1, 4]");
   r.read(t, p, "rolling_shutter", out.rolling_shutter);
+  r.read(t, p, "max_predicted_uncertainty_deg", out.max_predicted_uncertainty_deg,
+         [](double v) { return v >= 0 && v <= 180; }, "a number in [0, 180] (degrees)");
   if (const toml::table* blur = r.table(t, p, "blur")) {
     const std::string bp = "render.blur.";
     r.check_keys(*blur, bp, {"method", "samples", "min_motion_px"}, "[render.blur]");
@@ -613,6 +615,8 @@ std::string default_config_toml() {
         "\"map\": canvas pixels per core pixel, [1, 4]; finer edges, cost grows with its square");
   entry("rolling_shutter", b(d.render.rolling_shutter),
         "draw each row with its own exposure's pose when the readout time is non-zero");
+  entry("max_predicted_uncertainty_deg", f(d.render.max_predicted_uncertainty_deg),
+        "[0, 180]: a predicted pose less certain than this is not drawn");
   out += "\n[render.blur]                  # motion blur of the virtual layer over each exposure\n";
   entry("method", s(d.render.blur.method),
         "\"off\", \"accumulate\" (N renders: the reference), \"seed\" (2 renders + affine warps), \"velocity\" (fastest)");

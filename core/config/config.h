@@ -122,6 +122,9 @@ struct RenderConfig {
   // With a rolling shutter (non-zero readout time and a motion estimate) draw each vertex with the
   // pose of its own row's exposure, so the virtual layer skews like the picture.
   bool rolling_shutter = true;
+  // A predicted pose (track.max_predicted_frames) is drawn only while its stated uncertainty is at
+  // most this many degrees: past it the object would stand visibly in the wrong place.
+  double max_predicted_uncertainty_deg = 5.0;
   BlurConfig blur;
 
   bool operator==(const RenderConfig&) const = default;

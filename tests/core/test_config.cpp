@@ -69,7 +69,7 @@ TEST(Config, DefaultTomlReadsBackAsTheDefaultConfigAndListsEveryKey) {
         "[track]", "enabled = ", "family = ", "quad_decimate = ", "quad_sigma = ", "threads = ", "max_hamming = ",
         "min_decision_margin = ", "ambiguity_ratio = ", "max_predicted_frames = ", "[[track.bundle]]", "id = ", "size_m = ", "center_m = ",
         "yaw_deg = ", "[motion]", "latency_frames = ", "default_exposure_ms = ", "[render]", "light_direction = ", "light_color = ", "ambient = ", "msaa_samples = ",
-        "egl_platform = ", "lens = ", "lens_canvas_scale = ", "rolling_shutter = ", "[render.blur]", "method = ", "samples = ",
+        "egl_platform = ", "lens = ", "lens_canvas_scale = ", "rolling_shutter = ", "max_predicted_uncertainty_deg = ", "[render.blur]", "method = ", "samples = ",
         "min_motion_px = ", "[[render.objects]]", "mesh = ", "position_m = ",
         "scale = ", "color = ", "[sinks.png]", "dir = ", "every = ", "[sinks.y4m]", "[sinks.recording]",
         "[sinks.results]", "[pipeline]", "queue_depth = ", "max_frames = ", "log_level = "})
@@ -440,9 +440,11 @@ TEST(Config, BlurKeysHaveTheirDefaultsAndReadBack) {
   EXPECT_EQ(d.render.blur.samples, 0);
   EXPECT_EQ(d.render.blur.min_motion_px, 0.5);
   EXPECT_TRUE(d.render.rolling_shutter);
+  EXPECT_EQ(d.render.max_predicted_uncertainty_deg, 5.0);
   const Config c = parse_config(
-      "[render]\nrolling_shutter = false\n[render.blur]\nmethod = \"velocity\"\nsamples = 16\nmin_motion_px = 2\n", "b.toml");
+      "[render]\nrolling_shutter = false\nmax_predicted_uncertainty_deg = 12\n[render.blur]\nmethod = \"velocity\"\nsamples = 16\nmin_motion_px = 2\n", "b.toml");
   EXPECT_FALSE(c.render.rolling_shutter);
+  EXPECT_EQ(c.render.max_predicted_uncertainty_deg, 12.0);
   EXPECT_EQ(c.render.blur.method, "velocity");
   EXPECT_EQ(c.render.blur.samples, 16);
   EXPECT_EQ(c.render.blur.min_motion_px, 2.0);
@@ -456,6 +458,8 @@ TEST(Config, BlurValuesOutOfRangeAreRefusedNamingFileAndKey) {
   expect_error("[render.blur]\nsamples = 2000\n", {"'render.blur.samples'", "got 2000"});
   expect_error("[render.blur]\nmin_motion_px = -0.5\n", {"'render.blur.min_motion_px'", "got -0.5"});
   expect_error("[render.blur]\nwidth = 3\n", {"unknown key 'render.blur.width'"});
+  expect_error("[render]\nmax_predicted_uncertainty_deg = -1\n",
+               {"test.toml:2:", "'render.max_predicted_uncertainty_deg' expected a number in [0, 180] (degrees)"});
 }
 
 }  // namespace

@@ -277,9 +277,20 @@ TEST(MotionBlur, APredictedPoseIsDrawnAndBlurred) {
   FrameContext ctx = make_context(black_frame(), pinhole_camera(), motion.T_cam_world_mid, TrackState::Predicted);
   ctx.motion = motion;
   ctx.motion.max_image_motion_px = 12.0;
+  ctx.pose.predicted_uncertainty_deg = 2.0;  // within the default render.max_predicted_uncertainty_deg (5)
   harness().stages.process(ctx);
   EXPECT_TRUE(ctx.virtual_layer_drawn);
   EXPECT_EQ(ctx.blur_method, "seed");
+
+  // Past the bound the object would stand visibly in the wrong place: not drawn, and said why.
+  FrameContext uncertain = make_context(black_frame(), pinhole_camera(), motion.T_cam_world_mid, TrackState::Predicted);
+  uncertain.motion = ctx.motion;
+  uncertain.pose.predicted_uncertainty_deg = 10.0;
+  harness().stages.process(uncertain);
+  EXPECT_FALSE(uncertain.virtual_layer_drawn);
+  const StageTiming* render = find_timing(uncertain, "render");
+  ASSERT_NE(render, nullptr);
+  EXPECT_EQ(render->skipped, "predicted pose too uncertain (10.0 > 5.0 deg)");
 }
 
 }  // namespace
