@@ -12,6 +12,7 @@
 
 #include "render/egl_context.h"
 #include "render/gl_error.h"
+#include "tests/render/gl_readback.h"
 
 namespace arpipe {
 namespace {
@@ -47,17 +48,6 @@ GlTexture coordinate_canvas(const PinholeCanvas& canvas, float offset) {
   return texture;
 }
 
-std::vector<float> read_rgba32f(GLuint texture, int width, int height) {
-  GlFramebuffer framebuffer = GlFramebuffer::create();
-  glBindFramebuffer(GL_FRAMEBUFFER, framebuffer.get());
-  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture, 0);
-  std::vector<float> pixels(size_t(width) * height * 4);
-  glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, pixels.data());
-  glBindFramebuffer(GL_FRAMEBUFFER, 0);
-  check_gl("reading the warp back");
-  return pixels;
-}
-
 bool float_targets_available() {
   // Rendering to RGBA32F and filtering it are extensions in GLES 3.0 (llvmpipe has both).
   return context().has_gl_extension("GL_EXT_color_buffer_float") &&
@@ -75,7 +65,7 @@ TEST(LensWarpPass, EveryPixelSamplesTheCanvasWhereTheMapPoints) {
   pass.run(first.get(), PixelRect::full(kWidth, kHeight));
   const PixelRect rect{37, 411, 250, 69};  // reaching the bottom-left corner
   pass.run(second.get(), rect);
-  const std::vector<float> out = read_rgba32f(pass.texture(), kWidth, kHeight);
+  const std::vector<float> out = render_test::read_rgba_float(pass.texture(), kWidth, kHeight);
   double worst = 0;
   for (int y = 0; y < kHeight; ++y)
     for (int x = 0; x < kWidth; ++x) {

@@ -15,6 +15,7 @@
 
 #include "render/egl_context.h"
 #include "render/gl_error.h"
+#include "tests/render/gl_readback.h"
 #include "render/render_errors.h"
 
 namespace arpipe {
@@ -59,17 +60,6 @@ std::vector<float> image_of(int width, int height, Rgba (*texel)(int x, int y)) 
       std::copy(t.begin(), t.end(), texels.begin() + (ptrdiff_t(y) * width + x) * 4);
     }
   return texels;
-}
-
-std::vector<float> read_back(GLuint texture, int width, int height) {
-  GlFramebuffer framebuffer = GlFramebuffer::create();
-  glBindFramebuffer(GL_FRAMEBUFFER, framebuffer.get());
-  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture, 0);
-  std::vector<float> pixels(size_t(width) * height * 4);
-  glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, pixels.data());
-  glBindFramebuffer(GL_FRAMEBUFFER, 0);
-  check_gl("reading the seed blur back");
-  return pixels;
 }
 
 const float* at(const std::vector<float>& pixels, int x, int y, int width = kWidth) {
@@ -136,7 +126,7 @@ TEST_F(SeedBlurPassTest, TranslatedSamplesAverageToTheBoxBlur) {
                                             : sample(0, 1, Affine2::identity(), back));
     }
     pass.run(first.get(), second.get(), kWidth, kHeight, plan, PixelRect::full(kWidth, kHeight));
-    const std::vector<float> out = read_back(pass.texture(), kWidth, kHeight);
+    const std::vector<float> out = render_test::read_rgba_float(pass.texture(), kWidth, kHeight);
     double worst = 0;
     for (int y = 0; y < kHeight; ++y)
       for (int x = 0; x < kWidth; ++x) {
@@ -165,7 +155,7 @@ TEST_F(SeedBlurPassTest, CrossFadeGivesTheWeightedMix) {
   SeedBlurPlan plan;
   plan.samples.push_back(sample(0.3, 0.7, Affine2::identity(), Affine2::identity()));
   pass.run(first.get(), second.get(), kWidth, kHeight, plan, PixelRect::full(kWidth, kHeight));
-  const std::vector<float> out = read_back(pass.texture(), kWidth, kHeight);
+  const std::vector<float> out = render_test::read_rgba_float(pass.texture(), kWidth, kHeight);
   for (int y = 0; y < kHeight; ++y)
     for (int x = 0; x < kWidth; ++x)
       for (int c = 0; c < 4; ++c)
@@ -187,7 +177,7 @@ TEST_F(SeedBlurPassTest, IdentityReproducesTheInput) {
   SeedBlurPlan plan;
   plan.samples.push_back(sample(1, 0, Affine2::identity(), Affine2::translation({3, 1})));
   pass.run(first.get(), second.get(), kWidth, kHeight, plan, PixelRect::full(kWidth, kHeight));
-  const std::vector<float> out = read_back(pass.texture(), kWidth, kHeight);
+  const std::vector<float> out = render_test::read_rgba_float(pass.texture(), kWidth, kHeight);
   double worst = 0;
   for (size_t i = 0; i < out.size(); ++i) {
     worst = std::max(worst, double(std::abs(out[i] - texels[i])));
@@ -208,7 +198,7 @@ TEST_F(SeedBlurPassTest, OutsideTheTexturesIsTransparent) {
   plan.samples.push_back(sample(1, 0, Affine2::translation({30, 0}), Affine2::identity()));   // p reads p + 30
   plan.samples.push_back(sample(0, 1, Affine2::identity(), Affine2::translation({0, -1000})));  // all outside
   pass.run(first.get(), second.get(), kWidth, kHeight, plan, PixelRect::full(kWidth, kHeight));
-  const std::vector<float> out = read_back(pass.texture(), kWidth, kHeight);
+  const std::vector<float> out = render_test::read_rgba_float(pass.texture(), kWidth, kHeight);
   for (int y = 0; y < kHeight; ++y)
     for (int x = 0; x < kWidth; ++x) {
       const double inside = x + 30 <= kWidth - 1 ? 0.5 : 0.0;  // of the two samples, one at most
@@ -230,7 +220,7 @@ TEST_F(SeedBlurPassTest, OnlyRectIsWrittenAndAnEmptyPlanClearsIt) {
   const PixelRect rect{20, 85, 50, 35}, cleared{100, 0, 60, 10};  // reaching the bottom and right edges
   pass.run(first.get(), second.get(), kWidth, kHeight, from_second, rect);
   pass.run(first.get(), second.get(), kWidth, kHeight, SeedBlurPlan{}, cleared);
-  const std::vector<float> out = read_back(pass.texture(), kWidth, kHeight);
+  const std::vector<float> out = render_test::read_rgba_float(pass.texture(), kWidth, kHeight);
   for (int y = 0; y < kHeight; ++y)
     for (int x = 0; x < kWidth; ++x)
       for (int c = 0; c < 4; ++c) {
@@ -248,7 +238,7 @@ TEST_F(SeedBlurPassTest, FiftySamplesRunFiftyOneThrow) {
   for (int i = 0; i < SeedBlurPass::kMaxSamples; ++i)  // alternating textures: all 50 slots are read
     plan.samples.push_back(sample(i % 2, 1 - i % 2, Affine2::identity(), Affine2::identity()));
   pass.run(first.get(), second.get(), kWidth, kHeight, plan, PixelRect::full(kWidth, kHeight));
-  const std::vector<float> out = read_back(pass.texture(), kWidth, kHeight);
+  const std::vector<float> out = render_test::read_rgba_float(pass.texture(), kWidth, kHeight);
   for (size_t i = 0; i < out.size(); ++i)
     ASSERT_NEAR(out[i], texels[i], kHalfFloat * texels[i] + kLeak) << "value " << i;
   plan.samples.push_back(plan.samples.back());

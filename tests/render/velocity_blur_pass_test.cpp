@@ -17,6 +17,7 @@
 
 #include "render/egl_context.h"
 #include "render/gl_error.h"
+#include "tests/render/gl_readback.h"
 
 namespace arpipe {
 namespace {
@@ -72,17 +73,6 @@ Layer make_layer(const std::vector<Square>& squares, int width = kWidth, int hei
   layer.color_texture = upload(layer.color, width, height);
   layer.velocity_texture = upload(layer.velocity, width, height);
   return layer;
-}
-
-std::vector<float> read_back(GLuint texture, int width = kWidth, int height = kHeight) {
-  GlFramebuffer framebuffer = GlFramebuffer::create();
-  glBindFramebuffer(GL_FRAMEBUFFER, framebuffer.get());
-  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture, 0);
-  std::vector<float> pixels(size_t(width) * height * 4);
-  glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, pixels.data());
-  glBindFramebuffer(GL_FRAMEBUFFER, 0);
-  check_gl("reading the velocity blur back");
-  return pixels;
 }
 
 // The accumulation buffer's answer for one square: the part of u in [-1/2, 1/2] for which
@@ -156,7 +146,7 @@ TEST_F(VelocityBlurPassTest, UniformMotionAlongXGivesTheBoxBlur) {
     Layer layer = make_layer({square});
     pass.run(layer.color_texture.get(), layer.velocity_texture.get(), kWidth, kHeight,
              PixelRect::full(kWidth, kHeight), kSamples);
-    const std::vector<float> out = read_back(pass.texture());
+    const std::vector<float> out = render_test::read_rgba_float(pass.texture(), kWidth, kHeight);
     if (length < 0.5) {
       for (size_t i = 0; i < out.size(); ++i) ASSERT_EQ(out[i], layer.color[i]) << "L " << length << " value " << i;
       continue;
@@ -179,7 +169,7 @@ TEST_F(VelocityBlurPassTest, DiagonalMotionGivesTheBoxBlur) {
   Layer layer = make_layer({square});
   pass.run(layer.color_texture.get(), layer.velocity_texture.get(), kWidth, kHeight,
            PixelRect::full(kWidth, kHeight), kSamples);
-  const std::vector<float> out = read_back(pass.texture());
+  const std::vector<float> out = render_test::read_rgba_float(pass.texture(), kWidth, kHeight);
   const double h = (15.0 / 2 - 0.5) / (kSamples / 2);
   const double bound = 2 * (h * h / 4 + 1.25 / 8) / 15 + 1.0 / 512 + kHalfFloat;
   const double worst = max_error(out, {square}, bound);
@@ -198,7 +188,7 @@ TEST_F(VelocityBlurPassTest, OppositeMotionsBlurEachTheirOwnWay) {
   Layer layer = make_layer({left, right});
   pass.run(layer.color_texture.get(), layer.velocity_texture.get(), kWidth, kHeight,
            PixelRect::full(kWidth, kHeight), kSamples);
-  const std::vector<float> out = read_back(pass.texture());
+  const std::vector<float> out = render_test::read_rgba_float(pass.texture(), kWidth, kHeight);
   // The slower square's taps are spaced for 16 px but weighted by 1/12.
   const double h = (16.0 / 2 - 0.5) / (kSamples / 2);
   const double bound = (h * h / 4 + 1.0 / 8) / 12 + 1.0 / 512 + kHalfFloat;
@@ -218,7 +208,7 @@ TEST_F(VelocityBlurPassTest, NearerStaticSurfaceHidesWhatPassesBehind) {
   Layer layer = make_layer({moving, front});
   pass.run(layer.color_texture.get(), layer.velocity_texture.get(), kWidth, kHeight,
            PixelRect::full(kWidth, kHeight), kSamples);
-  const std::vector<float> out = read_back(pass.texture());
+  const std::vector<float> out = render_test::read_rgba_float(pass.texture(), kWidth, kHeight);
   for (int y = front.y0; y <= front.y1; ++y)
     for (int x = front.x0; x <= front.x1; ++x)
       for (int c = 0; c < 4; ++c)
@@ -240,7 +230,7 @@ TEST_F(VelocityBlurPassTest, OnlyRectIsWritten) {
   Layer second = make_layer({moving});
   const PixelRect rect{45, 50, 40, 70};  // over the left ramp, down to the bottom edge
   pass.run(second.color_texture.get(), second.velocity_texture.get(), kWidth, kHeight, rect, kSamples);
-  const std::vector<float> out = read_back(pass.texture());
+  const std::vector<float> out = render_test::read_rgba_float(pass.texture(), kWidth, kHeight);
   for (int y = 0; y < kHeight; ++y)
     for (int x = 0; x < kWidth; ++x) {
       const float alpha = out[(size_t(y) * kWidth + x) * 4 + 3];
