@@ -54,6 +54,7 @@ class MotionBlurDrawer {
   MotionBlurDrawer(const EglContext& context, GLenum layer_format);
   // Compiles what a method needs now rather than on its first blurred frame.
   void prepare(BlurMethod method);
+  void prepare_shadows(ShadowMethod method) { objects_.prepare(method); }
 
   LayerDrawResult draw(VirtualLayer& layer, const LayerDrawRequest& request, const BlurConfig& config);
 

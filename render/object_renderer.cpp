@@ -5,38 +5,69 @@
 
 #include <array>
 
+#include "render/shadow_lookup_glsl.h"
+
 namespace arpipe {
 namespace {
 
 constexpr std::string_view kShadingVertexShader = R"glsl(
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
-uniform mat3 u_world_from_object_rotation;
+uniform mat3 u_world_from_object_rotation;  // without the scale
+uniform vec3 u_world_from_object_translation;
+uniform float u_object_scale;
 out vec3 v_normal_world;
+out vec3 v_world;
 
 void main() {
   gl_Position = camera_to_clip(pose_camera_point(a_position));
-  // The camera's motion does not turn the object in the world, so one normal serves every row.
+  // The camera's motion does not move the object in the world, so one normal and one world
+  // position serve every row.
   v_normal_world = u_world_from_object_rotation * a_normal;
+  v_world = u_world_from_object_rotation * (u_object_scale * a_position) + u_world_from_object_translation;
 }
 )glsl";
 
-constexpr std::string_view kShadingFragmentShader = R"glsl(#version 300 es
+constexpr std::string_view kShadingFragmentShaderTemplate = R"glsl(#version 300 es
 precision highp float;
 in vec3 v_normal_world;
+in vec3 v_world;
 uniform vec4 u_base_color;       // linear, straight alpha
 uniform vec3 u_light_direction;  // world frame, unit, towards the light
+uniform vec4 u_light_position;   // w = 1: a lamp there (the direction is per point)
 uniform vec3 u_light_color;
 uniform vec3 u_ambient;
+uniform vec3 u_ambient_sh[9];
+uniform float u_exposure_scale;
+uniform bool u_shadow_catcher;
 out vec4 out_color;              // linear, premultiplied alpha
+{shadow_lookup}
+vec3 ambient_at(vec3 n) {{
+  return u_ambient + 0.282095 * u_ambient_sh[0]
+       + 0.488603 * (n.y * u_ambient_sh[1] + n.z * u_ambient_sh[2] + n.x * u_ambient_sh[3])
+       + 1.092548 * (n.x * n.y * u_ambient_sh[4] + n.y * n.z * u_ambient_sh[5] + n.x * n.z * u_ambient_sh[7])
+       + 0.315392 * (3.0 * n.z * n.z - 1.0) * u_ambient_sh[6] + 0.546274 * (n.x * n.x - n.y * n.y) * u_ambient_sh[8];
+}}
 
-void main() {
+void main() {{
   vec3 normal = normalize(v_normal_world);
   if (!gl_FrontFacing) normal = -normal;  // the inside of an open mesh faces the other way
-  float lambert = max(dot(normal, u_light_direction), 0.0);
-  vec3 rgb = u_base_color.rgb * (u_ambient + u_light_color * lambert);
+  vec3 towards_light = u_light_position.w > 0.5 ? normalize(u_light_position.xyz - v_world) : u_light_direction;
+  float lambert = max(dot(normal, towards_light), 0.0);
+  float visibility = shadow_visibility(v_world);  // uniform control flow: it takes derivatives
+  if (u_shadow_catcher) {{
+    // Differential rendering: the real ground's light with the virtual shadow over its light
+    // without it. One ratio for all channels (the layer has one alpha), by luminance.
+    const vec3 luma = vec3(0.2126, 0.7152, 0.0722);
+    float ambient = max(dot(ambient_at(normal), luma), 0.0);
+    float direct = dot(u_light_color, luma) * lambert;
+    float ratio = ambient + direct > 0.0 ? (ambient + visibility * direct) / (ambient + direct) : 1.0;
+    out_color = vec4(0.0, 0.0, 0.0, 1.0 - ratio);
+    return;
+  }}
+  vec3 rgb = u_base_color.rgb * max(ambient_at(normal) + u_light_color * (lambert * visibility), 0.0) * u_exposure_scale;
   out_color = vec4(rgb * u_base_color.a, u_base_color.a);
-}
+}}
 )glsl";
 
 constexpr std::string_view kVelocityVertexShader = R"glsl(
@@ -105,23 +136,55 @@ void set_depth_state() {
 }  // namespace
 
 ObjectRenderer::ObjectRenderer()
-    : shading_("object shading", vertex_source({"pose"}, kShadingVertexShader), kShadingFragmentShader),
-      velocity_("object velocity", vertex_source({"mid", "start", "end"}, kVelocityVertexShader), kVelocityFragmentShader) {}
+    : velocity_("object velocity", vertex_source({"mid", "start", "end"}, kVelocityVertexShader), kVelocityFragmentShader) {
+  prepare(ShadowMethod::Off);
+}
+
+void ObjectRenderer::prepare(ShadowMethod method) { shading(method); }
+
+const GlProgram& ObjectRenderer::shading(ShadowMethod method) {
+  auto found = shading_.find(method);
+  if (found == shading_.end()) {
+    const std::string fragment = fmt::format(fmt::runtime(kShadingFragmentShaderTemplate),
+                                             fmt::arg("shadow_lookup", shadow_lookup_glsl(method)));
+    found = shading_
+                .emplace(method, GlProgram(fmt::format("object shading ({} shadows)", shadow_method_name(method)),
+                                           vertex_source({"pose"}, kShadingVertexShader), fragment))
+                .first;
+  }
+  return found->second;
+}
 
 void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, const Lighting& lighting,
-                          std::span<const ObjectAtInstant> objects) const {
+                          std::span<const ObjectAtInstant> objects) {
+  const ShadowMethod method = lighting.shadow ? lighting.shadow->method : ShadowMethod::Off;
+  const GlProgram& program = shading(method);
   set_depth_state();
-  set_lens_uniforms(shading_, lens);  // binds the program
-  set_row_projection(shading_, rows);
-  set_vec3(shading_.uniform("u_light_direction"), lighting.direction);
-  set_vec3(shading_.uniform("u_light_color"), lighting.color);
-  set_vec3(shading_.uniform("u_ambient"), lighting.ambient);
-  const GLint world_from_object_rotation = shading_.uniform("u_world_from_object_rotation");
-  const GLint base_color = shading_.uniform("u_base_color");
+  set_lens_uniforms(program, lens);  // binds the program
+  set_row_projection(program, rows);
+  set_vec3(program.uniform("u_light_direction"), lighting.direction);
+  glUniform4f(program.uniform("u_light_position"), static_cast<float>(lighting.position[0]),
+              static_cast<float>(lighting.position[1]), static_cast<float>(lighting.position[2]), lighting.local ? 1.0f : 0.0f);
+  set_vec3(program.uniform("u_light_color"), lighting.color);
+  set_vec3(program.uniform("u_ambient"), lighting.ambient);
+  std::array<float, 27> sh{};
+  for (size_t i = 0; i < 9; ++i)
+    for (size_t c = 0; c < 3; ++c) sh[i * 3 + c] = static_cast<float>(lighting.ambient_sh[i][c]);
+  glUniform3fv(program.uniform("u_ambient_sh"), 9, sh.data());
+  glUniform1f(program.uniform("u_exposure_scale"), static_cast<float>(lighting.exposure_scale));
+  if (lighting.shadow) set_shadow_lookup_uniforms(program, *lighting.shadow, 1);
+  const GLint world_from_object_rotation = program.uniform("u_world_from_object_rotation");
+  const GLint world_from_object_translation = program.uniform("u_world_from_object_translation");
+  const GLint object_scale = program.uniform("u_object_scale");
+  const GLint base_color = program.uniform("u_base_color");
+  const GLint shadow_catcher = program.uniform("u_shadow_catcher");
   for (const ObjectAtInstant& item : objects) {
-    set_row_poses(shading_, "pose", item.poses, item.object->scale);
+    set_row_poses(program, "pose", item.poses, item.object->scale);
     const std::array<float, 9> rotation = column_major(item.object->T_world_object.rotation());
     glUniformMatrix3fv(world_from_object_rotation, 1, GL_FALSE, rotation.data());
+    set_vec3(world_from_object_translation, item.object->T_world_object.translation());
+    glUniform1f(object_scale, static_cast<float>(item.object->scale));
+    glUniform1i(shadow_catcher, item.object->shadow_catcher ? 1 : 0);
     item.object->mesh->draw([&](const MeshPart& part) {
       const std::array<float, 4>& color = item.object->base_color ? *item.object->base_color : part.base_color;
       glUniform4f(base_color, color[0], color[1], color[2], color[3]);

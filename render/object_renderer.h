@@ -3,19 +3,31 @@
 // per-pixel image velocity over the exposure that the velocity blur gathers along.
 #pragma once
 
+#include <array>
+#include <map>
 #include <span>
 
 #include "render/gl_program.h"
 #include "render/lens_projection.h"
 #include "render/render_objects.h"
 #include "render/row_poses.h"
+#include "render/shadow_map.h"
 
 namespace arpipe {
 
+// A surface of base colour (albedo) c shows c * (ambient(n) + color * max(n.l, 0) * visibility)
+// * exposure_scale, with ambient(n) = ambient + sum_i ambient_sh[i] * Y_i(n) (real SH, Green's
+// order): for an estimate in scene-linear units, color = E / pi and ambient_sh the ambient
+// irradiance's SH over pi, and exposure_scale turns scene-linear into the frame's linear pixels.
 struct Lighting {
   Vec3 direction{0, 0, 1};  // world frame, unit, towards the light
+  bool local = false;       // a lamp at `position`: the direction is then taken per point
+  Vec3 position{0, 0, 0};
   Vec3 color{1, 1, 1};
   Vec3 ambient{0, 0, 0};
+  std::array<Vec3, 9> ambient_sh{};
+  double exposure_scale = 1;
+  const ShadowLookup* shadow = nullptr;  // nullptr: nothing is shadowed
 };
 
 struct ObjectAtInstant {
@@ -32,18 +44,24 @@ class ObjectRenderer {
  public:
   // Compiles both programs; needs a current context. Throws RenderError.
   ObjectRenderer();
+  // Compiles the shading program that reads this method's shadow map now, not on first use.
+  void prepare(ShadowMethod method);
 
   // Linear, premultiplied colour with depth test, into the bound framebuffer (viewport and
-  // scissor as set by the caller), with the lens as the projection.
+  // scissor as set by the caller), with the lens as the projection. A shadow catcher
+  // (RenderObject::shadow_catcher) draws no colour: its alpha is 1 - the ratio by which the
+  // virtual objects' shadow darkens the real ground, (ambient + visibility * direct) /
+  // (ambient + direct) in luminance, so the composite multiplies the camera frame by that ratio.
   void draw(const LensUniforms& lens, const RowProjection& rows, const Lighting& lighting,
-            std::span<const ObjectAtInstant> objects) const;
+            std::span<const ObjectAtInstant> objects);
   // rg = end minus start image position (pixels of the lens image), b = depth at mid-exposure (m),
   // a = 1, with depth test at the mid-exposure position; for a float colour target.
   void draw_velocity(const LensUniforms& lens, const RowProjection& rows,
                      std::span<const ObjectOverExposure> objects) const;
 
  private:
-  GlProgram shading_;
+  const GlProgram& shading(ShadowMethod method);
+  std::map<ShadowMethod, GlProgram> shading_;  // one per shadow lookup
   GlProgram velocity_;
 };
 

@@ -22,6 +22,9 @@ struct RenderObject {
   SE3 T_world_object;                    // placement without the scale
   double scale = 1.0;
   std::optional<std::array<float, 4>> base_color;  // set for builtin meshes (config colour); else the file's
+  // The real ground under the objects (render/shadow_receiver.h): drawn as the shadow's
+  // darkening, never as a surface, and it casts nothing.
+  bool shadow_catcher = false;
 };
 
 

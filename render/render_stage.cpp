@@ -5,7 +5,10 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <numbers>
 #include <optional>
 
 #include "core/log.h"
@@ -22,6 +25,13 @@ namespace {
 // Covers the multisampled edge pixels and the bend of distorted edges between sampled points.
 constexpr double kRectMarginPx = 2.0;
 constexpr int kExposureInstants = 8;  // pieces of the exposure whose ends bound the footprint
+// The shadow map follows the light in steps of this angle, so that a light estimate's
+// frame-to-frame jitter does not redraw it every frame (a shadow 10 cm long moves 0.1 mm).
+constexpr double kRadiansPerDegree = std::numbers::pi / 180;
+constexpr double kShadowLightStepRad = 0.05 * kRadiansPerDegree;
+// Spherical-harmonic convolution with the clamped cosine (Ramamoorthi and Hanrahan), over pi:
+// ambient irradiance / pi from the radiance's coefficients, band by band.
+constexpr double kIrradianceOverPi[3] = {1.0, 2.0 / 3.0, 0.25};
 
 }  // namespace
 
@@ -31,6 +41,8 @@ RenderStage::~RenderStage() {
   session_->try_make_current();
   objects_.clear();
   warp_pass_.reset();
+  shadow_pass_.reset();
+  receiver_.reset();
   drawer_.reset();
 }
 
@@ -46,6 +58,7 @@ void RenderStage::configure(const Config& config) {
   settings.msaa_samples = config.render.msaa_samples;
   const double light_length = norm(config.render.light_direction);
   settings.light_direction = light_length > 0 ? (1.0 / light_length) * config.render.light_direction : Vec3{0, 0, 1};
+  settings.light_distance_m = config.render.light_distance_m;
   settings.light_color = config.render.light_color;
   settings.ambient = config.render.ambient;
   settings.lens = parse_lens_mode(config.render.lens);
@@ -53,6 +66,15 @@ void RenderStage::configure(const Config& config) {
   settings.rolling_shutter = config.render.rolling_shutter;
   settings.max_predicted_uncertainty_deg = config.render.max_predicted_uncertainty_deg;
   settings.blur = config.render.blur;
+  settings.shadows = config.render.shadows;
+  settings.shadow_method = parse_shadow_method(config.render.shadows.method);
+  drawer_->prepare_shadows(settings.shadow_method);
+  if (settings.shadow_method == ShadowMethod::Off) {
+    shadow_pass_.reset();
+  } else if (!shadow_pass_ || shadow_pass_->config() != settings.shadows) {
+    shadow_pass_ = std::make_unique<ShadowMapPass>(session_->context(), settings.shadows);
+  }
+  if (!receiver_) receiver_ = std::make_unique<ShadowReceiver>();
 
   // The warp's shader is compiled here rather than on the first frame that needs it.
   if (settings.lens == LensMode::Map && !warp_pass_)
@@ -160,6 +182,7 @@ void RenderStage::draw(FrameContext& ctx) {
     if (in_view) request.objects.push_back(&object);
   }
   if (request.objects.empty()) return;
+  session_->make_current();
 
   // "map": draw on the pinhole canvas, in the part of it that the output rectangle samples.
   std::shared_ptr<const LensWarpMap> warp;
@@ -173,7 +196,17 @@ void RenderStage::draw(FrameContext& ctx) {
   request.lens = lens_uniforms(canvas_camera);
   request.canvas_camera = &canvas_camera;
   request.rows = {camera.fy(), camera.cy(), camera.height()};
-  request.lighting = {settings_.light_direction, settings_.light_color, settings_.ambient};
+  double angular_diameter_rad = 0;
+  request.lighting = frame_lighting(ctx, angular_diameter_rad);
+  request.lighting.shadow = shadow_for(ctx, request.lighting, angular_diameter_rad, request.objects);
+  if (request.lighting.shadow) {
+    // The catcher's patch joins the footprint where it is in view.
+    const RenderObject& catcher = *request.objects.back();
+    for (const SE3& T_cam_world : exposure_poses)
+      if (std::optional<PixelRect> r =
+              projected_box_rect(image_camera, T_cam_world * catcher.T_world_object, catcher.bounds, kRectMarginPx))
+        rect = rect.united(*r);
+  }
   request.rect = warp ? warp->canvas_rect_for(rect) : rect;
   request.image_motion_px = ctx.motion.valid() ? ctx.motion.max_image_motion_px : 0;
   request.msaa_samples = settings_.msaa_samples;
@@ -197,6 +230,82 @@ void RenderStage::draw(FrameContext& ctx) {
   ctx.virtual_layer_drawn = true;
   ctx.blur_method = std::string(blur_method_name(drawn.method));
   ctx.blur_samples = drawn.samples;
+}
+
+}  // namespace arpipe
+
+namespace arpipe {
+
+Lighting RenderStage::frame_lighting(const FrameContext& ctx, double& angular_diameter_rad) const {
+  Lighting lighting;
+  const LightEstimate& light = ctx.light;
+  if (!light.scene_linear || light.state == LightState::None || light.state == LightState::Fixed) {
+    lighting.direction = settings_.light_direction;
+    lighting.color = settings_.light_color;
+    lighting.ambient = settings_.ambient;
+    lighting.local = settings_.light_distance_m > 0;
+    lighting.position = settings_.light_distance_m * settings_.light_direction;
+    angular_diameter_rad = settings_.shadows.light_angular_diameter_deg * kRadiansPerDegree;
+    return lighting;
+  }
+  // Scene-linear: irradiance over pi multiplies the albedo, and the frame's exposure and gain
+  // turn the result into its linear pixel values.
+  constexpr double pi = std::numbers::pi;
+  lighting.color = {0, 0, 0};
+  if (!light.lights.empty() && light.state != LightState::NoDirect) {
+    lighting.direction = light.lights.front().direction_world;
+    lighting.local = light.lights.front().local;
+    lighting.position = light.lights.front().position_world;
+    lighting.color = (1 / pi) * light.lights.front().irradiance;
+    angular_diameter_rad = light.lights.front().angular_diameter_rad;
+  }
+  for (size_t i = 0; i < 9; ++i) {
+    const size_t band = i == 0 ? 0 : (i < 4 ? 1 : 2);
+    lighting.ambient_sh[i] = kIrradianceOverPi[band] * light.ambient_sh[i];
+  }
+  // Further lights have no shadow map: they light the objects as ambient does (their irradiance
+  // on a surface facing them, spread by the SH of a single direction would be finer; see the note).
+  for (size_t k = 1; k < light.lights.size(); ++k) lighting.ambient = lighting.ambient + (0.25 / pi) * light.lights[k].irradiance;
+  const double exposure_s = 1e-9 * double(ctx.camera.meta.exposure_ns);
+  lighting.exposure_scale = exposure_s > 0 ? exposure_s * ctx.camera.meta.total_gain() : 1.0;
+  return lighting;
+}
+
+const ShadowLookup* RenderStage::shadow_for(FrameContext& ctx, const Lighting& lighting, double angular_diameter_rad,
+                                            std::vector<const RenderObject*>& drawn) {
+  const auto start = std::chrono::steady_clock::now();
+  const auto skip = [&](std::string why) -> const ShadowLookup* {
+    ctx.record_timing("shadow", milliseconds_since(start), std::move(why));
+    return nullptr;
+  };
+  if (!shadow_pass_) return skip("shadows off");
+  if (norm(lighting.color) <= 0) return skip("no direct light");
+  if (std::acos(std::clamp(dot(lighting.direction, shadow_light_direction_), -1.0, 1.0)) > kShadowLightStepRad)
+    shadow_light_direction_ = lighting.direction;
+  std::vector<ShadowCaster> casters;
+  std::vector<const RenderObject*> caster_objects;
+  double extent = 0;
+  for (const RenderObject& object : objects_) {
+    casters.push_back({object.bounds, object.T_world_object});
+    caster_objects.push_back(&object);
+    extent = std::max(extent, norm(object.bounds.max - object.bounds.min));
+  }
+  // The penumbra of the tallest object, and a little more for the filters' reach.
+  const double margin = extent * (std::tan(angular_diameter_rad) + 0.05);
+  const std::optional<ShadowFrustum> frustum =
+      lighting.local
+          ? fit_local_shadow_frustum(lighting.position, casters, settings_.shadows.receiver_height_m, margin)
+          : fit_shadow_frustum(shadow_light_direction_, casters, settings_.shadows.receiver_height_m, margin);
+  if (!frustum) return skip(lighting.local ? "lamp not above the objects" : "light below the ground");
+  const RenderObject& catcher = receiver_->over(frustum->receiver);
+  // Variance maps also hold the ground, so that filtering across an object's edge blends its depth
+  // with the ground's rather than with empty space.
+  if (is_variance_method(settings_.shadow_method)) caster_objects.push_back(&catcher);
+  const bool drew = shadow_pass_->render(*frustum, caster_objects, angular_diameter_rad);
+  drawn.push_back(&catcher);
+  if (drew) glFinish();  // honest timings: the work is queued until something waits
+  ctx.record_timing("shadow", milliseconds_since(start), drew ? "" : "reused");
+  return &shadow_pass_->lookup();
 }
 
 }  // namespace arpipe

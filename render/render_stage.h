@@ -15,6 +15,8 @@
 #include "render/per_model_cache.h"
 #include "render/render_objects.h"
 #include "render/render_session.h"
+#include "render/shadow_map.h"
+#include "render/shadow_receiver.h"
 
 namespace arpipe {
 
@@ -42,6 +44,7 @@ class RenderStage final : public Stage {
     bool enabled = true;
     int msaa_samples = 4;
     Vec3 light_direction{0, 0, 1};
+    double light_distance_m = 0;
     Vec3 light_color{1, 1, 1};
     Vec3 ambient{0, 0, 0};
     LensMode lens = LensMode::Map;
@@ -49,14 +52,23 @@ class RenderStage final : public Stage {
     bool rolling_shutter = true;
     double max_predicted_uncertainty_deg = 5.0;
     BlurConfig blur;
+    ShadowConfig shadows;
+    ShadowMethod shadow_method = ShadowMethod::Off;
   };
   void draw(FrameContext& ctx);
+  Lighting frame_lighting(const FrameContext& ctx, double& angular_diameter_rad) const;
+  // The shadow map for this frame's light, or nullptr (ctx gets a "shadow" timing saying why).
+  const ShadowLookup* shadow_for(FrameContext& ctx, const Lighting& lighting, double angular_diameter_rad,
+                                 std::vector<const RenderObject*>& drawn);
   std::shared_ptr<const LensWarpMap> warp_map(const std::shared_ptr<const CameraModel>& camera_model);
   std::shared_ptr<const CameraModel> pinhole_core(const std::shared_ptr<const CameraModel>& camera_model);
 
   std::shared_ptr<RenderSession> session_;  // first member: outlives the GL objects below
   std::unique_ptr<MotionBlurDrawer> drawer_;  // the objects' programs and the blur passes
   std::unique_ptr<LensWarpPass> warp_pass_;  // made by configure with render.lens = "map"
+  std::unique_ptr<ShadowMapPass> shadow_pass_;  // made by configure unless render.shadows.method = "off"
+  std::unique_ptr<ShadowReceiver> receiver_;
+  Vec3 shadow_light_direction_{0, 0, 0};  // what the shadow map was made for (moves in steps)
   PerModelCache<LensWarpMap> warp_maps_;
   PerModelCache<CameraModel> pinhole_cores_;  // render.lens = "undistort": what the output sees
   std::vector<RenderObject> objects_;

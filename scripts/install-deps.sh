@@ -10,6 +10,7 @@ packages=(
   libmrcal-dev libdogleg-dev libapriltag-dev libopencv-dev libglm-dev
   libmrgingham-dev libeigen3-dev libsuitesparse-dev
   libtomlplusplus-dev nlohmann-json3-dev libsystemd-dev libfmt-dev
+  libgeographiclib-dev
   # render: EGL + GLES 3 on Mesa (llvmpipe when there is no GPU)
   libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri libgbm1
   libtinygltf-dev libembree-dev libstb-dev libpng-dev

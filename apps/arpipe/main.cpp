@@ -24,6 +24,10 @@ commands:
   bench blur [--capture DIR | --scene FILE] [--out DIR] [--frames N] [--reference-samples N]
                                      motion-blur methods: time against error (PSNR, SSIM)
                                      vs the converged reference and the simulator's truth
+  sun --lat DEG --lon DEG --time ISO8601 [--alt M] [--delta-t S] [--pressure MBAR] [--temperature C]
+      [--heading DEG] [--declination DEG] [--algorithm spa|psa|both]
+                                     the sun's azimuth, elevation and direction (ENU, anchor
+                                     frame) for a place and time (NREL SPA and/or PSA)
   config --defaults                  print a config with every key at its default
   config --check FILE                validate a config file
 )";
@@ -45,6 +49,7 @@ int main(int argc, char** argv) {
   if (command == "calib") return arpipe::run_calib(args);
   if (command == "board") return arpipe::run_board(args);
   if (command == "bench") return arpipe::run_bench(args);
+  if (command == "sun") return arpipe::run_sun(args);
   std::fprintf(stderr, "arpipe: unknown command '%s'\n%s", command.c_str(), kUsage);
   return 2;
 }

@@ -7,6 +7,7 @@
 #include "capture/sinks/recording_sink.h"
 #include "capture/sinks/results_sink.h"
 #include "capture/sinks/y4m_sink.h"
+#include "core/light/light_stage.h"
 #include "core/motion/motion_stage.h"
 #include "core/track/tag_tracker.h"
 #include "render/lens_mode.h"
@@ -34,10 +35,13 @@ StageFactory make_stage_factory(const Config& config) {
   // The motion stage needs the tracker's poses. It stays out of the list when disabled (a config
   // reload cannot add it; it can switch it off, since the stage checks motion.enabled per frame).
   const bool motion = config.track.enabled && config.motion.enabled;
-  return [motion] {
+  // Likewise the light stage: only for a probe or the sun (the fixed light needs no stage).
+  const bool light = config.light.source != "fixed";
+  return [motion, light] {
     std::vector<std::unique_ptr<Stage>> stages;
     stages.push_back(std::make_unique<TagTracker>());
     if (motion) stages.push_back(std::make_unique<MotionStage>());
+    if (light) stages.push_back(std::make_unique<LightStage>());
     for (auto& stage : make_render_stages()) stages.push_back(std::move(stage));
     return stages;
   };

@@ -63,6 +63,7 @@ struct Surface {
   std::vector<Rgb> triangle_albedo;
   // Light: the radiance of its surface.
   Rgb emitted{0, 0, 0};
+  bool is_virtual = false;  // an object only the ground-truth composite shows
 };
 
 struct DirectionalLight {
@@ -110,6 +111,7 @@ struct SceneShader::Impl {
     const SimMaterial& material = object.material;
     surface.mirror = material.kind == SimMaterial::Kind::Mirror;
     surface.albedo = material.albedo;
+    surface.is_virtual = object.is_virtual;
     check_object(material.texture.kind == SimTexture::Kind::None || object.shape == SimObject::Shape::Plane, object,
                  "textures cover planes only");
     check_object(material.texture.kind == SimTexture::Kind::None || !surface.mirror, object,
@@ -351,6 +353,11 @@ SceneShader::~SceneShader() = default;
 
 Rgb SceneShader::radiance(const Vec3& origin, const Vec3& dir, SampleRng& rng) const {
   return impl_->trace(origin, normalized(dir), rng);
+}
+
+bool SceneShader::sees_virtual_object(const Vec3& origin, const Vec3& dir) const {
+  const ShapeHit hit = impl_->scene.intersect(origin, normalized(dir));
+  return hit.hit() && hit.shape < impl_->surfaces.size() && impl_->surfaces[hit.shape].is_virtual;
 }
 
 }  // namespace arpipe::sim

@@ -53,6 +53,27 @@ std::string ResultsSink::to_json_line(const FrameContext& ctx) {
     motion["why_none"] = std::string(ctx.motion.why_none);
   }
   j["motion"] = motion;
+  if (ctx.light.state != LightState::None || !ctx.light.note.empty()) {
+    // The light stage's estimate (absent with the config's fixed light): scene-linear units.
+    json light = {{"state", std::string(light_state_name(ctx.light.state))},
+                  {"source", ctx.light.source},
+                  {"confidence", ctx.light.confidence}};
+    if (ctx.light.frames_since_measured > 0) light["frames_since_measured"] = ctx.light.frames_since_measured;
+    if (!ctx.light.note.empty()) light["note"] = ctx.light.note;
+    json lights = json::array();
+    for (const DirectionalLight& l : ctx.light.lights) {
+      json entry = {{"direction_world", {l.direction_world[0], l.direction_world[1], l.direction_world[2]}},
+                    {"irradiance", {l.irradiance[0], l.irradiance[1], l.irradiance[2]}},
+                    {"angular_diameter_deg", l.angular_diameter_rad * 180 / 3.14159265358979323846}};
+      if (l.local) entry["position_world"] = {l.position_world[0], l.position_world[1], l.position_world[2]};
+      lights.push_back(entry);
+    }
+    light["lights"] = lights;
+    json sh = json::array();
+    for (const Vec3& c : ctx.light.ambient_sh) sh.push_back({c[0], c[1], c[2]});
+    light["ambient_sh"] = sh;
+    j["light"] = light;
+  }
   j["virtual_layer_drawn"] = ctx.virtual_layer_drawn;
   if (ctx.virtual_layer_drawn) j["blur"] = {{"method", ctx.blur_method}, {"samples", ctx.blur_samples}};
   json timings = json::object();

@@ -11,6 +11,7 @@
 #include <cctype>
 #include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <functional>
@@ -308,11 +309,93 @@ void read_motion(const ConfigReader& r, const toml::table& t, MotionConfig& out)
   }
 }
 
+void read_shadows(const ConfigReader& r, const toml::table& t, ShadowConfig& out) {
+  const std::string p = "render.shadows.";
+  r.check_keys(t, p,
+               {"method", "map_size", "pcf_kernel", "vsm_blur", "vsm_bleed_reduction", "depth_bias_texels",
+                "receiver_height_m", "light_angular_diameter_deg"},
+               "[render.shadows]");
+  r.read(t, p, "method", out.method, {"off", "hard", "pcf", "pcss", "vsm", "vsm-packed"});
+  r.read(t, p, "map_size", out.map_size);
+  if (out.map_size != 256 && out.map_size != 512 && out.map_size != 1024 && out.map_size != 2048 && out.map_size != 4096)
+    r.fail_got(*t.get("map_size"), p + "map_size", "one of 256, 512, 1024, 2048, 4096", fmt::format("{}", out.map_size));
+  r.read(t, p, "pcf_kernel", out.pcf_kernel, 1, 16);
+  r.read(t, p, "vsm_blur", out.vsm_blur, 1, 31);
+  if (out.vsm_blur % 2 == 0)
+    r.fail_got(*t.get("vsm_blur"), p + "vsm_blur", "an odd integer in [1, 31] (taps across a centred kernel)",
+               fmt::format("{}", out.vsm_blur));
+  r.read(t, p, "vsm_bleed_reduction", out.vsm_bleed_reduction, [](double v) { return v >= 0 && v < 0.95; },
+         "a number in [0, 0.95)");
+  r.read(t, p, "depth_bias_texels", out.depth_bias_texels, [](double v) { return v >= 0 && v <= 100; },
+         "a number in [0, 100] (texels)");
+  r.read(t, p, "receiver_height_m", out.receiver_height_m);
+  r.read(t, p, "light_angular_diameter_deg", out.light_angular_diameter_deg,
+         [](double v) { return v >= 0 && v < 90; }, "a number in [0, 90) (degrees)");
+}
+
+bool is_camera_response(const std::string& text) {
+  if (text == "srgb" || text == "linear") return true;
+  if (text.rfind("gamma:", 0) != 0) return false;
+  char* end = nullptr;
+  const double g = std::strtod(text.c_str() + 6, &end);
+  return end != text.c_str() + 6 && *end == '\0' && std::isfinite(g) && g > 0 && g <= 10;
+}
+
+void read_light(const ConfigReader& r, const toml::table& t, LightConfig& out) {
+  const std::string p = "light.";
+  r.check_keys(t, p, {"source", "response", "smoothing_s", "ground_albedo", "probe", "sun"}, "[light]");
+  r.read(t, p, "source", out.source, {"fixed", "probe", "sun"});
+  r.read(t, p, "response", out.response);
+  if (!is_camera_response(out.response))
+    r.fail_got(*t.get("response"), p + "response", "\"srgb\", \"linear\" or \"gamma:<g>\" with 0 < g <= 10",
+               toml_string(out.response));
+  r.read(t, p, "smoothing_s", out.smoothing_s, [](double v) { return v >= 0 && v <= 60; }, "a number in [0, 60] (s)");
+  r.read(t, p, "ground_albedo", out.ground_albedo, [](double v) { return v > 0 && v <= 1; }, "numbers in (0, 1]");
+  if (const toml::table* probe = r.table(t, p, "probe")) {
+    const std::string pp = "light.probe.";
+    r.check_keys(*probe, pp, {"kind", "center_m", "radius_m", "reflectance", "method", "max_lights", "light_distance_m"},
+                   "[light.probe]");
+    r.read(*probe, pp, "kind", out.probe.kind, {"mirror", "diffuse"});
+    r.read(*probe, pp, "center_m", out.probe.center_m);
+    r.read(*probe, pp, "radius_m", out.probe.radius_m, [](double v) { return v > 0 && v <= 10; }, "a number in (0, 10] (m)");
+    r.read(*probe, pp, "reflectance", out.probe.reflectance, [](double v) { return v > 0 && v <= 1; },
+           "a number in (0, 1]");
+    r.read(*probe, pp, "method", out.probe.method, {"auto", "environment", "fit", "seed-image", "seed-sphere"});
+    r.read(*probe, pp, "max_lights", out.probe.max_lights, 1, 4);
+    r.read(*probe, pp, "light_distance_m", out.probe.light_distance_m, [](double v) { return v >= 0 && v <= 1e6; },
+           "a number in [0, 1e6] (m; 0: infinitely far)");
+  }
+  if (const toml::table* sun = r.table(t, p, "sun")) {
+    const std::string sp = "light.sun.";
+    r.check_keys(*sun, sp,
+                 {"latitude_deg", "longitude_deg", "altitude_m", "time", "heading_deg", "declination_deg",
+                  "pressure_mbar", "temperature_c", "direct_fraction"},
+                 "[light.sun]");
+    r.read(*sun, sp, "latitude_deg", out.sun.latitude_deg, [](double v) { return v >= -90 && v <= 90; },
+           "a latitude in [-90, 90] (degrees, north positive)");
+    r.read(*sun, sp, "longitude_deg", out.sun.longitude_deg, [](double v) { return v >= -180 && v <= 180; },
+           "a longitude in [-180, 180] (degrees, east positive)");
+    r.read(*sun, sp, "altitude_m", out.sun.altitude_m, [](double v) { return v >= -500 && v <= 20000; },
+           "a number in [-500, 20000] (m)");
+    r.read(*sun, sp, "time", out.sun.time);
+    r.read(*sun, sp, "heading_deg", out.sun.heading_deg, [](double v) { return v >= -360 && v <= 360; },
+           "a number in [-360, 360] (degrees)");
+    r.read(*sun, sp, "declination_deg", out.sun.declination_deg, [](double v) { return v >= -180 && v <= 180; },
+           "a number in [-180, 180] (degrees, east positive)");
+    r.read(*sun, sp, "pressure_mbar", out.sun.pressure_mbar, [](double v) { return v > 0 && v <= 5000; },
+           "a number in (0, 5000] (mbar)");
+    r.read(*sun, sp, "temperature_c", out.sun.temperature_c, [](double v) { return v > -273 && v <= 6000; },
+           "a number in (-273, 6000] (degrees Celsius)");
+    r.read(*sun, sp, "direct_fraction", out.sun.direct_fraction, [](double v) { return v >= 0 && v <= 1; },
+           "a number in [0, 1]");
+  }
+}
+
 void read_render(const ConfigReader& r, const toml::table& t, RenderConfig& out) {
   const std::string p = "render.";
   r.check_keys(t, p,
-               {"enabled", "objects", "light_direction", "light_color", "ambient", "msaa_samples", "egl_platform",
-                "lens", "lens_canvas_scale", "rolling_shutter", "max_predicted_uncertainty_deg", "blur"},
+               {"enabled", "objects", "light_direction", "light_distance_m", "light_color", "ambient", "msaa_samples", "egl_platform",
+                "lens", "lens_canvas_scale", "rolling_shutter", "max_predicted_uncertainty_deg", "blur", "shadows"},
                "[render]");
   r.read(t, p, "enabled", out.enabled);
   if (const toml::array* objects = r.array_of_tables(t, p, "objects")) {
@@ -336,6 +419,8 @@ void read_render(const ConfigReader& r, const toml::table& t, RenderConfig& out)
   if (length == 0) r.fail(*t.get("light_direction"), p + "light_direction", "a non-zero direction");
   // A vector already of unit length is kept bit for bit, so printing and reading a config is exact.
   if (std::abs(length - 1.0) > 1e-12) out.light_direction = normalized(out.light_direction);
+  r.read(t, p, "light_distance_m", out.light_distance_m, [](double v) { return v >= 0 && v <= 1e6; },
+         "a number in [0, 1e6] (m; 0: infinitely far)");
   r.read(t, p, "light_color", out.light_color, non_negative, "numbers >= 0");
   r.read(t, p, "ambient", out.ambient, non_negative, "numbers >= 0");
   r.read(t, p, "msaa_samples", out.msaa_samples);
@@ -357,6 +442,7 @@ void read_render(const ConfigReader& r, const toml::table& t, RenderConfig& out)
     r.read(*blur, bp, "min_motion_px", out.blur.min_motion_px, [](double v) { return v >= 0 && v <= 1000; },
            "a number in [0, 1000] (pixels)");
   }
+  if (const toml::table* shadows = r.table(t, p, "shadows")) read_shadows(r, *shadows, out.shadows);
 }
 
 void read_sinks(const ConfigReader& r, const toml::table& t, SinksConfig& out) {
@@ -396,10 +482,11 @@ Config read_config(const toml::table& root, const std::string& source) {
   const ConfigReader r(source);
   Config config;
   config.file = source;
-  r.check_keys(root, "", {"source", "track", "motion", "render", "sinks", "pipeline"}, "the top level");
+  r.check_keys(root, "", {"source", "track", "motion", "light", "render", "sinks", "pipeline"}, "the top level");
   if (const toml::table* t = r.table(root, "", "source")) read_source(r, *t, config.source);
   if (const toml::table* t = r.table(root, "", "track")) read_track(r, *t, config.track);
   if (const toml::table* t = r.table(root, "", "motion")) read_motion(r, *t, config.motion);
+  if (const toml::table* t = r.table(root, "", "light")) read_light(r, *t, config.light);
   if (const toml::table* t = r.table(root, "", "render")) read_render(r, *t, config.render);
   if (const toml::table* t = r.table(root, "", "sinks")) read_sinks(r, *t, config.sinks);
   if (const toml::table* t = r.table(root, "", "pipeline")) read_pipeline(r, *t, config.pipeline);
@@ -597,9 +684,37 @@ std::string default_config_toml() {
   entry("default_exposure_ms", f(double(d.motion.default_exposure_ns) * 1e-6),
         "(0, 1000]: for frames without an exposure time; capped at the frame interval");
 
+  out += "\n[light]                        # where the light comes from\n";
+  entry("source", s(d.light.source),
+        "\"fixed\" (render.light_*), \"probe\" (a probe sphere in view) or \"sun\" (place and time)");
+  entry("response", s(d.light.response), "camera response: \"srgb\", \"linear\" or \"gamma:<g>\"");
+  entry("smoothing_s", f(d.light.smoothing_s), "[0, 60]: time constant of the temporal smoothing");
+  entry("ground_albedo", vec(d.light.ground_albedo),
+        "(0, 1]: of the real ground, whose brightness sets the sun's level and a clipped lamp's");
+  out += "\n[light.probe]                  # a light probe sphere beside the anchor\n";
+  entry("kind", s(d.light.probe.kind), "\"mirror\" or \"diffuse\"");
+  entry("center_m", vec(d.light.probe.center_m), "world frame");
+  entry("radius_m", f(d.light.probe.radius_m), "(0, 10]");
+  entry("reflectance", f(d.light.probe.reflectance), "(0, 1]: mirror reflectance, or the diffuse sphere's albedo");
+  entry("method", s(d.light.probe.method),
+        "\"auto\", \"environment\", \"fit\", \"seed-image\" or \"seed-sphere\"");
+  entry("max_lights", fmt::format("{}", d.light.probe.max_lights), "1..4 dominant lights");
+  entry("light_distance_m", f(d.light.probe.light_distance_m), "0: lights infinitely far; > 0: the key lamp's distance from the probe");
+  out += "\n[light.sun]                    # the sun from place and time (NREL SPA)\n";
+  entry("latitude_deg", f(d.light.sun.latitude_deg), "[-90, 90], north positive");
+  entry("longitude_deg", f(d.light.sun.longitude_deg), "[-180, 180], east positive");
+  entry("altitude_m", f(d.light.sun.altitude_m));
+  entry("time", s(d.light.sun.time), "\"now\" (system UTC clock) or an ISO 8601 instant for the first frame");
+  entry("heading_deg", f(d.light.sun.heading_deg), "bearing of the anchor's +y axis from true north, clockwise");
+  entry("declination_deg", f(d.light.sun.declination_deg), "magnetic declination, east positive, for a compass heading");
+  entry("pressure_mbar", f(d.light.sun.pressure_mbar), "for refraction");
+  entry("temperature_c", f(d.light.sun.temperature_c), "for refraction");
+  entry("direct_fraction", f(d.light.sun.direct_fraction), "[0, 1]: the sun's share of the light on the ground");
+
   out += "\n[render]\n";
   entry("enabled", b(d.render.enabled));
   entry("light_direction", vec(d.render.light_direction), "world frame, towards the light; normalised on load");
+  entry("light_distance_m", f(d.render.light_distance_m), "0: infinitely far; > 0: a lamp that far along light_direction");
   entry("light_color", vec(d.render.light_color), "linear RGB, >= 0");
   entry("ambient", vec(d.render.ambient), "linear RGB, >= 0");
   entry("msaa_samples", fmt::format("{}", d.render.msaa_samples), "0, 1, 2 or 4");
@@ -622,6 +737,17 @@ std::string default_config_toml() {
         "\"off\", \"accumulate\" (N renders: the reference), \"seed\" (2 renders + affine warps), \"velocity\" (fastest)");
   entry("samples", fmt::format("{}", d.render.blur.samples), "0..1024; 0: from the frame's image motion");
   entry("min_motion_px", f(d.render.blur.min_motion_px), "frames with less image motion are drawn sharp");
+  out += "\n[render.shadows]               # shadows of the virtual objects, on themselves and on the real ground\n";
+  entry("method", s(d.render.shadows.method),
+        "\"off\", \"hard\", \"pcf\", \"pcss\" (penumbra from the light's size), \"vsm\" or \"vsm-packed\" (RGBA8)");
+  entry("map_size", fmt::format("{}", d.render.shadows.map_size), "texels across: 256, 512, 1024, 2048 or 4096");
+  entry("pcf_kernel", fmt::format("{}", d.render.shadows.pcf_kernel), "pcf: k x k taps, 1..16");
+  entry("vsm_blur", fmt::format("{}", d.render.shadows.vsm_blur), "vsm: Gaussian taps across, odd, 1..31");
+  entry("vsm_bleed_reduction", f(d.render.shadows.vsm_bleed_reduction), "vsm: [0, 0.95), cuts light bleeding");
+  entry("depth_bias_texels", f(d.render.shadows.depth_bias_texels), "self-shadowing bias, [0, 100] texels");
+  entry("receiver_height_m", f(d.render.shadows.receiver_height_m), "world z of the real ground");
+  entry("light_angular_diameter_deg", f(d.render.shadows.light_angular_diameter_deg),
+        "[0, 90): size of the fixed light (pcss); estimates bring their own");
   out += "\n# Virtual objects: one [[render.objects]] each, placed in the world (anchor) frame.\n";
   for (const SceneObject& object : d.render.objects) {
     out += "[[render.objects]]\n";

@@ -99,10 +99,33 @@ struct BlurConfig {
   bool operator==(const BlurConfig&) const = default;
 };
 
+// Shadows of the virtual objects on themselves and on the real ground (docs/ARCHITECTURE.md,
+// "Light and shadows"): a shadow map from the directional light, filtered by `method`.
+struct ShadowConfig {
+  // "off", "hard" (the seed's binary test), "pcf" (k x k percentage-closer filter), "pcss"
+  // (penumbra from the light's angular size), "vsm" (variance shadow map, float moments), or
+  // "vsm-packed" (the seed's 16-bit moments packed in RGBA8, for GLES 2-class hardware).
+  std::string method = "pcss";
+  int map_size = 1024;                   // texels across: 256, 512, 1024, 2048 or 4096
+  int pcf_kernel = 3;                    // pcf: k x k taps, 1..16 (the seed: 3 real time, 8 for quality)
+  int vsm_blur = 7;                      // vsm: Gaussian taps across, odd, 1..31 (the seed: 7)
+  double vsm_bleed_reduction = 0.2;      // vsm: cuts the Chebyshev tail below this, [0, 0.95)
+  double depth_bias_texels = 1.5;        // self-shadowing bias, in texels of the map's width
+  double receiver_height_m = 0.0;        // world z of the real ground the shadows fall on
+  // The size of the config's fixed light (render.light_direction), for pcss; probe and sun
+  // estimates bring their own (0.53 degrees for the sun).
+  double light_angular_diameter_deg = 2.0;
+
+  bool operator==(const ShadowConfig&) const = default;
+};
+
 struct RenderConfig {
   bool enabled = true;
   std::vector<SceneObject> objects{SceneObject{}};
   Vec3 light_direction = normalized(Vec3{0.3, -0.4, 1.0});  // world frame, towards the light; unit length
+  // 0: the light is infinitely far (a directional light); > 0: a lamp this far from the world
+  // origin along light_direction (shadows fan out from it).
+  double light_distance_m = 0;
   Vec3 light_color{1.0, 1.0, 1.0};       // linear
   Vec3 ambient{0.25, 0.25, 0.25};        // linear
   int msaa_samples = 4;
@@ -126,8 +149,61 @@ struct RenderConfig {
   // most this many degrees: past it the object would stand visibly in the wrong place.
   double max_predicted_uncertainty_deg = 5.0;
   BlurConfig blur;
+  ShadowConfig shadows;
 
   bool operator==(const RenderConfig&) const = default;
+};
+
+// A light probe sphere beside the anchor (core/light): where it is and what it is made of.
+struct ProbeConfig {
+  std::string kind = "mirror";           // "mirror" or "diffuse"
+  Vec3 center_m{-0.15, 0.10, 0.04};      // world (anchor) frame
+  double radius_m = 0.04;
+  double reflectance = 0.9;              // mirror: specular reflectance; diffuse: albedo, (0, 1]
+  // "auto" (environment for a mirror, fit for a diffuse sphere), "environment", "fit",
+  // "seed-image" or "seed-sphere" (the seed's brightest-component method, image or sphere domain).
+  std::string method = "auto";
+  int max_lights = 1;                    // dominant lights kept, 1..4
+  // 0: the lights are infinitely far; > 0: the strongest is a lamp this far from the probe's
+  // centre (measured by hand: a probe sees directions only).
+  double light_distance_m = 0;
+
+  bool operator==(const ProbeConfig&) const = default;
+};
+
+// The sun from place and time (core/light): NREL's SPA, turned into the anchor frame.
+struct SunConfig {
+  double latitude_deg = 0;               // [-90, 90], north positive
+  double longitude_deg = 0;              // [-180, 180], east positive
+  double altitude_m = 0;
+  // "now": the system's UTC clock at each frame (live cameras); or an ISO 8601 instant for the
+  // first frame, later frames adding their own time since it (replays).
+  std::string time = "now";
+  double heading_deg = 0;                // bearing of the anchor's +y axis from true north, clockwise
+  double declination_deg = 0;            // added to heading_deg when it was read off a compass
+  double pressure_mbar = 1013.25;        // for refraction
+  double temperature_c = 15;
+  // The sun's share of the light on the ground under a clear sky; the rest is sky. The ground
+  // itself (light.ground_albedo) sets the overall level, measured per frame around the anchor.
+  double direct_fraction = 0.85;
+
+  bool operator==(const SunConfig&) const = default;
+};
+
+// The light stage: where the light comes from.
+struct LightConfig {
+  // "fixed": render.light_direction, light_color and ambient (display-referred, no estimation);
+  // "probe": a light probe sphere in view ([light.probe]); "sun": place and time ([light.sun]).
+  std::string source = "fixed";
+  std::string response = "srgb";         // the camera's response curve: "srgb", "linear" or "gamma:<g>"
+  double smoothing_s = 0.3;              // time constant of the temporal smoothing, [0, 60]
+  // The real ground around the anchor, whose brightness gives the light's strength where nothing
+  // else can: the sun always, and a probe whose brightest light is clipped.
+  Vec3 ground_albedo{0.3, 0.3, 0.3};
+  ProbeConfig probe;
+  SunConfig sun;
+
+  bool operator==(const LightConfig&) const = default;
 };
 
 struct PngSinkConfig {
@@ -178,6 +254,7 @@ struct Config {
   SourceConfig source;
   TrackConfig track;
   MotionConfig motion;
+  LightConfig light;
   RenderConfig render;
   SinksConfig sinks;
   PipelineConfig pipeline;

@@ -11,6 +11,7 @@
 #include "core/frame.h"
 #include "core/geometry/camera_model.h"
 #include "core/geometry/se3.h"
+#include "core/light/light_estimate.h"
 #include "core/motion/shutter_motion.h"
 
 namespace arpipe {
@@ -57,6 +58,9 @@ struct FrameContext {
   PoseEstimate pose;
   // The camera's motion over this frame's exposure (the motion stage); state None until then.
   ShutterMotion motion;
+  // The light (the light stage); state None when no light stage ran: the renderer then uses the
+  // config's fixed light.
+  LightEstimate light;
   Frame output;                                 // the composited frame, RGB24; empty until composed
   // The lens that ctx.output is seen through: camera_model, or its pinhole core when render.lens
   // is "undistort" (the output is then an undistorted picture). Set with ctx.output.

@@ -1,6 +1,8 @@
-// The procedural meshes a scene can name without a file ("builtin:cube", "builtin:pyramid"):
+// The procedural meshes a scene can name without a file ("builtin:cube", "builtin:pyramid", "builtin:sphere"):
 // base on z = 0, centred on the object origin in x and y, about 6 cm across.
 #include "core/scene/builtin_meshes.h"
+
+#include <cmath>
 
 namespace arpipe {
 namespace {
@@ -82,11 +84,41 @@ Mesh make_pyramid_mesh(double base_m, double height_m, int subdivisions) {
   return builder.finish();
 }
 
+Mesh make_sphere_mesh(double radius_m, int rings) {
+  // Latitude-longitude rings, 2 * rings segments around; smooth normals (the true sphere's).
+  MeshBuilder builder;
+  const int segments = 2 * rings;
+  const double pi = 3.14159265358979323846;
+  for (int j = 0; j <= rings; ++j) {
+    const double theta = pi * j / rings;  // from the top
+    for (int i = 0; i <= segments; ++i) {
+      const double phi = 2 * pi * i / segments;
+      const Vec3 n{std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)};
+      builder.add_vertex(Vec3{0, 0, radius_m} + radius_m * n, n);
+    }
+  }
+  auto at = [&](int i, int j) { return static_cast<uint32_t>(j * (segments + 1) + i); };
+  for (int j = 0; j < rings; ++j)
+    for (int i = 0; i < segments; ++i) {
+      // Counter-clockwise seen from outside; the pole rows' degenerate triangles are left out.
+      if (j > 0) builder.add_triangle(at(i, j), at(i, j + 1), at(i + 1, j));
+      if (j < rings - 1) builder.add_triangle(at(i + 1, j), at(i, j + 1), at(i + 1, j + 1));
+    }
+  return builder.finish();
+}
+
+Mesh make_plane_mesh(double edge_m, int subdivisions) {
+  MeshBuilder builder;
+  builder.add_grid({-edge_m / 2, -edge_m / 2, 0}, {edge_m, 0, 0}, {0, edge_m, 0}, subdivisions);  // facing +z
+  return builder.finish();
+}
+
 bool is_builtin_mesh_source(std::string_view source) { return source.substr(0, kBuiltinMeshPrefix.size()) == kBuiltinMeshPrefix; }
 
 std::optional<Mesh> make_builtin_mesh(std::string_view source) {
   if (source == "builtin:cube") return make_cube_mesh();
   if (source == "builtin:pyramid") return make_pyramid_mesh();
+  if (source == "builtin:sphere") return make_sphere_mesh();
   return std::nullopt;
 }
 

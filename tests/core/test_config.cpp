@@ -218,7 +218,7 @@ TEST(Config, UnknownKeysAreErrorsWithPlaceAndAllowedKeys) {
                {"test.toml:3:1:", "unknown key 'track.famliy'", "allowed keys in [track]:", "family", "bundle",
                 "ambiguity_ratio"});
   expect_error("\n\n[tracking]\nenabled = true\n",
-               {"test.toml:3:", "unknown key 'tracking'", "source, track, motion, render, sinks, pipeline"});
+               {"test.toml:3:", "unknown key 'tracking'", "source, track, motion, light, render, sinks, pipeline"});
   expect_error("typo = 1\n", {"test.toml:1:1:", "unknown key 'typo'"});
   expect_error("[sinks.png]\nenabled = true\nquality = 9\n",
                {"test.toml:3:1:", "unknown key 'sinks.png.quality'", "allowed keys in [sinks.png]: enabled, dir, every"});

@@ -1,0 +1,78 @@
+// The ground's brightness around the anchor (see ground_radiance.h).
+#include "core/light/ground_radiance.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+namespace arpipe {
+namespace {
+
+// A ring far enough out to miss the anchor tag and near enough to be the ground the objects
+// stand on; the median copes with real objects and shadows on part of it.
+constexpr double kRingInner = 0.09, kRingOuter = 0.25;
+constexpr int kRingSamples = 96;
+constexpr double kPi = std::numbers::pi;
+
+}  // namespace
+
+std::optional<Vec3> GroundRadiance::measure(const Frame& frame, const CameraModel& camera, const SE3& T_cam_world,
+                                            const CameraResponse& response) {
+  std::vector<Vec2> pixels;
+  for (int i = 0; i < kRingSamples; ++i) {
+    const double angle = 2 * kPi * i / kRingSamples;
+    const double radius = kRingInner + (kRingOuter - kRingInner) * ((i * 7) % kRingSamples) / double(kRingSamples);
+    const Vec3 cam = T_cam_world * Vec3{radius * std::cos(angle), radius * std::sin(angle), 0};
+    if (cam[2] <= 0) continue;
+    if (const std::optional<Vec2> q = camera.project(cam))
+      if ((*q)[0] >= 0 && (*q)[1] >= 0 && (*q)[0] <= camera.width() - 1 && (*q)[1] <= camera.height() - 1)
+        pixels.push_back(*q);
+  }
+  if (int(pixels.size()) < kRingSamples / 4) return std::nullopt;
+  double x0 = 1e9, y0 = 1e9, x1 = -1e9, y1 = -1e9;
+  for (const Vec2& q : pixels) {
+    x0 = std::min(x0, q[0]);
+    y0 = std::min(y0, q[1]);
+    x1 = std::max(x1, q[0]);
+    y1 = std::max(y1, q[1]);
+  }
+  const ImageRect rect{int(x0), int(y0), int(x1) - int(x0) + 1, int(y1) - int(y0) + 1};
+  if (!decode_linear_patch(frame, rect, response, patch_)) return std::nullopt;
+  std::vector<std::array<float, 3>> values;
+  for (const Vec2& q : pixels) {
+    const int x = int(std::lround(q[0])), y = int(std::lround(q[1]));
+    if (!patch_.rect.contains(x, y) || patch_.clipped_at(x, y)) continue;
+    const float* rgb = patch_.at(x, y);
+    values.push_back({rgb[0], rgb[1], rgb[2]});
+  }
+  if (int(values.size()) < kRingSamples / 4) return std::nullopt;
+  Vec3 median{};
+  for (size_t c = 0; c < 3; ++c) {
+    std::vector<float> channel;
+    for (const auto& v : values) channel.push_back(v[c]);
+    std::nth_element(channel.begin(), channel.begin() + ptrdiff_t(channel.size() / 2), channel.end());
+    median[c] = channel[channel.size() / 2];
+  }
+  return median;
+}
+
+bool light_from_ground(DirectionalLight& light, const ShRgb9& ambient_sh, const Vec3& ground_radiance,
+                       const Vec3& ground_albedo) {
+  const double cos_ground = light.direction_world[2];
+  if (cos_ground < 0.1) return false;
+  // Irradiance on an upward surface from the ambient SH: A_l L_l0 Y_l0(up), A = pi, 2pi/3, pi/4.
+  Vec3 solved{};
+  for (size_t c = 0; c < 3; ++c) {
+    const double ambient = kPi * 0.282095 * ambient_sh[0][c] + (2 * kPi / 3) * 0.488603 * ambient_sh[2][c] +
+                           (kPi / 4) * 0.630784 * ambient_sh[6][c];
+    solved[c] = std::max(0.0, (kPi * ground_radiance[c] / ground_albedo[c] - ambient) / cos_ground);
+  }
+  const auto luminance = [](const Vec3& v) { return 0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2]; };
+  if (luminance(solved) <= luminance(light.irradiance)) return false;
+  light.irradiance = solved;
+  return true;
+}
+
+}  // namespace arpipe

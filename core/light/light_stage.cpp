@@ -1,0 +1,106 @@
+// The light stage (see light_stage.h).
+#include "core/light/light_stage.h"
+
+#include <fmt/format.h>
+#include <time.h>
+
+#include "core/log.h"
+#include "core/pipeline/monotonic_clock.h"
+
+namespace arpipe {
+namespace {
+
+int64_t realtime_minus_monotonic_ns() {
+  timespec real{}, mono{};
+  clock_gettime(CLOCK_REALTIME, &real);
+  clock_gettime(CLOCK_MONOTONIC, &mono);
+  return (int64_t(real.tv_sec) - int64_t(mono.tv_sec)) * 1'000'000'000 + (int64_t(real.tv_nsec) - int64_t(mono.tv_nsec));
+}
+
+}  // namespace
+
+void LightStage::configure(const Config& config) {
+  const LightConfig& light = config.light;
+  CameraResponse response;
+  try {
+    response = CameraResponse::parse(light.response, "light.response");
+  } catch (const std::exception& e) {
+    throw ConfigError(fmt::format("{}: {}", config.file.string(), e.what()));
+  }
+  std::unique_ptr<ProbeLightEstimator> probe;
+  std::unique_ptr<SunLight> sun;
+  Source source = Source::Fixed;
+  if (light.source == "probe") {
+    source = Source::Probe;
+    ProbeLightConfig c;
+    c.sphere.kind = light.probe.kind == "diffuse" ? ProbeSphere::Kind::Diffuse : ProbeSphere::Kind::Mirror;
+    c.sphere.center_world = light.probe.center_m;
+    c.sphere.radius_m = light.probe.radius_m;
+    c.sphere.reflectance = light.probe.reflectance;
+    c.method = light.probe.method == "auto" ? "" : light.probe.method;
+    c.max_lights = light.probe.max_lights;
+    c.smoothing_s = light.smoothing_s;
+    c.light_distance_m = light.probe.light_distance_m;
+    c.response = response;
+    probe = std::make_unique<ProbeLightEstimator>();
+    try {
+      probe->configure(c);
+    } catch (const std::exception& e) {
+      throw ConfigError(fmt::format("{}: [light.probe]: {}", config.file.string(), e.what()));
+    }
+  } else if (light.source == "sun") {
+    source = Source::Sun;
+    sun = std::make_unique<SunLight>();
+    sun->configure(light.sun, light.ground_albedo, response, light.smoothing_s, config.file);
+  }
+  source_ = source;
+  probe_ = std::move(probe);
+  sun_ = std::move(sun);
+  probe_centre_ = light.probe.center_m;
+  ground_albedo_ = light.ground_albedo;
+  response_ = response;
+  probe_light_distance_m_ = light.probe.light_distance_m;
+  last_note_.clear();
+}
+
+void LightStage::process(FrameContext& ctx) noexcept {
+  const auto start = std::chrono::steady_clock::now();
+  if (source_ == Source::Fixed) {
+    ctx.record_timing(std::string(name()), milliseconds_since(start), "fixed light (render.light_*)");
+    return;
+  }
+  const bool pose_valid = ctx.pose.state == TrackState::Tracking || ctx.pose.state == TrackState::Predicted;
+  if (!ctx.camera_model) {
+    ctx.record_timing(std::string(name()), milliseconds_since(start), "no camera model");
+    return;
+  }
+  if (source_ == Source::Probe) {
+    ctx.light = probe_->update(ctx.camera, *ctx.camera_model, ctx.pose.T_cam_world, pose_valid);
+    const ProbeDiagnostics& diag = probe_->diagnostics();
+    if (diag.measured && !ctx.light.lights.empty() && !diag.light_clipped.empty() && diag.light_clipped.front()) {
+      try {
+        if (std::optional<Vec3> ground = ground_.measure(ctx.camera, *ctx.camera_model, ctx.pose.T_cam_world, response_))
+          if (light_from_ground(ctx.light.lights.front(), ctx.light.ambient_sh, *ground, ground_albedo_))
+            ctx.light.note = "light 0 clipped in the probe: its strength is taken from the ground";
+      } catch (const std::exception&) {
+        // The lower bound stands.
+      }
+    }
+    // A probe sees directions only; a lamp's measured distance places it.
+    if (probe_light_distance_m_ > 0 && !ctx.light.lights.empty()) {
+      DirectionalLight& key = ctx.light.lights.front();
+      key.local = true;
+      key.position_world = probe_centre_ + probe_light_distance_m_ * key.direction_world;
+      key.direction_world = normalized(key.position_world);
+    }
+  } else {
+    ctx.light = sun_->update(ctx.camera, *ctx.camera_model, ctx.pose.T_cam_world, pose_valid, realtime_minus_monotonic_ns());
+  }
+  if (!ctx.light.note.empty() && ctx.light.note != last_note_) log::info("light: {}", ctx.light.note);
+  last_note_ = ctx.light.note;
+  const bool measured = ctx.light.state == LightState::Estimated || ctx.light.state == LightState::NoDirect;
+  ctx.record_timing(std::string(name()), milliseconds_since(start),
+                    measured ? "" : fmt::format("light {}", light_state_name(ctx.light.state)));
+}
+
+}  // namespace arpipe

@@ -1,0 +1,39 @@
+// The light stage: where this frame's light comes from (light.source): the config's fixed light,
+// a light probe sphere in view (probe_light_estimator.h), or the sun from place and time
+// (sun_light.h). Its estimate travels in FrameContext::light to the renderer.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "core/light/ground_radiance.h"
+#include "core/light/probe_light_estimator.h"
+#include "core/light/sun_light.h"
+#include "core/pipeline/stage.h"
+
+namespace arpipe {
+
+class LightStage final : public Stage {
+ public:
+  std::string_view name() const override { return "light"; }
+  // Throws ConfigError naming the key on a probe or sun setting that cannot work; the old setup
+  // then stays.
+  void configure(const Config& config) override;
+  // Fixed: records the skip and leaves ctx.light for the renderer's fixed light. Probe and sun:
+  // the estimate, Held or None with a note when this frame could not be measured.
+  void process(FrameContext& ctx) noexcept override;
+
+ private:
+  enum class Source { Fixed, Probe, Sun };
+  Source source_ = Source::Fixed;
+  std::unique_ptr<ProbeLightEstimator> probe_;
+  std::unique_ptr<SunLight> sun_;
+  Vec3 probe_centre_{0, 0, 0};
+  Vec3 ground_albedo_{0.3, 0.3, 0.3};
+  CameraResponse response_;
+  GroundRadiance ground_;
+  double probe_light_distance_m_ = 0;
+  std::string last_note_;  // logged once per distinct note
+};
+
+}  // namespace arpipe

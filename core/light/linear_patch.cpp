@@ -1,0 +1,93 @@
+#include "core/light/linear_patch.h"
+
+#include <algorithm>
+#include <cstring>
+
+#include "core/image/pixel_convert.h"
+
+namespace arpipe {
+
+namespace {
+
+int bytes_per_pixel(PixelFormat f) {
+  switch (f) {
+    case PixelFormat::GREY: return 1;
+    case PixelFormat::RGB24: return 3;
+    case PixelFormat::YUYV: return 2;
+    case PixelFormat::NV12: return 1;
+  }
+  return 1;
+}
+
+// Copies the aligned rectangle [x0, x0+w) x [y0, y0+h) into a small frame of the same format, so
+// to_rgb24 converts it exactly as it would the whole frame (chroma pairs kept whole).
+void crop(const Frame& f, int x0, int y0, int w, int h, Frame& out) {
+  out.meta = f.meta;
+  out.format = f.format;
+  out.width = w;
+  out.height = h;
+  out.bytes_per_line = min_bytes_per_line(f.format, w);
+  out.data.resize(image_bytes(f.format, w, h, out.bytes_per_line));
+  const size_t bpp = size_t(bytes_per_pixel(f.format));
+  for (int y = 0; y < h; ++y)
+    std::memcpy(&out.data[size_t(y) * out.bytes_per_line], &f.data[size_t(y0 + y) * f.bytes_per_line + size_t(x0) * bpp],
+                size_t(w) * bpp);
+  if (f.format == PixelFormat::NV12) {
+    const size_t src_uv = size_t(f.height) * f.bytes_per_line;
+    const size_t dst_uv = size_t(h) * out.bytes_per_line;
+    for (int y = 0; y < h / 2; ++y)
+      std::memcpy(&out.data[dst_uv + size_t(y) * out.bytes_per_line],
+                  &f.data[src_uv + size_t(y0 / 2 + y) * f.bytes_per_line + size_t(x0)], size_t(w));
+  }
+}
+
+}  // namespace
+
+bool decode_linear_patch(const Frame& frame, const ImageRect& rect_in, const CameraResponse& response,
+                         LinearPatch& out) {
+  const double exposure_s = double(frame.meta.exposure_ns) * 1e-9;
+  const double gain = frame.meta.total_gain();
+  if (frame.empty() || !(exposure_s > 0) || !(gain > 0)) return false;
+  if (image_bytes(frame.format, frame.width, frame.height, frame.bytes_per_line) > frame.data.size()) return false;
+  ImageRect r = rect_in;
+  const int x1 = std::min(frame.width, r.x0 + r.width), y1 = std::min(frame.height, r.y0 + r.height);
+  r.x0 = std::max(0, r.x0);
+  r.y0 = std::max(0, r.y0);
+  r.width = x1 - r.x0;
+  r.height = y1 - r.y0;
+  if (r.empty()) return false;
+  // Chroma alignment: YUYV pairs columns, NV12 pairs columns and rows.
+  const bool pair_x = frame.format == PixelFormat::YUYV || frame.format == PixelFormat::NV12;
+  const bool pair_y = frame.format == PixelFormat::NV12;
+  const int ax0 = pair_x ? r.x0 & ~1 : r.x0, ay0 = pair_y ? r.y0 & ~1 : r.y0;
+  int ax1 = pair_x ? std::min(frame.width, (x1 + 1) & ~1) : x1;
+  int ay1 = pair_y ? std::min(frame.height, (y1 + 1) & ~1) : y1;
+  thread_local Frame cropped;
+  thread_local std::vector<uint8_t> rgb8;
+  crop(frame, ax0, ay0, ax1 - ax0, ay1 - ay0, cropped);
+  to_rgb24(cropped, rgb8);
+  const int cw = ax1 - ax0;
+
+  out.rect = r;
+  out.to_scene_linear = 1.0 / (exposure_s * gain);
+  const size_t n = size_t(r.width) * size_t(r.height);
+  out.rgb.resize(n * 3);
+  out.clipped.resize(n);
+  const float scale = float(out.to_scene_linear);
+  const std::array<float, 256>& lut = response.lut();
+  for (int y = 0; y < r.height; ++y) {
+    const uint8_t* src = &rgb8[(size_t(y + r.y0 - ay0) * size_t(cw) + size_t(r.x0 - ax0)) * 3];
+    float* dst = &out.rgb[size_t(y) * size_t(r.width) * 3];
+    uint8_t* clip = &out.clipped[size_t(y) * size_t(r.width)];
+    for (int x = 0; x < r.width; ++x) {
+      const uint8_t a = src[3 * x], b = src[3 * x + 1], c = src[3 * x + 2];
+      dst[3 * x] = lut[a] * scale;
+      dst[3 * x + 1] = lut[b] * scale;
+      dst[3 * x + 2] = lut[c] * scale;
+      clip[x] = std::max({a, b, c}) >= CameraResponse::kClippedFrom ? 1 : 0;
+    }
+  }
+  return true;
+}
+
+}  // namespace arpipe
