@@ -9,7 +9,8 @@ namespace arpipe {
 
 int run_bench(const Args& args) {
   if (!args.empty() && args[0] == "blur") return run_bench_blur(Args(args.begin() + 1, args.end()));
-  std::fputs("usage: arpipe bench blur [OPTIONS]   (arpipe bench blur --help for the options)\n", stderr);
+  if (!args.empty() && args[0] == "shadows") return run_bench_shadows(Args(args.begin() + 1, args.end()));
+  std::fputs("usage: arpipe bench blur|shadows [OPTIONS]   (arpipe bench NAME --help for the options)\n", stderr);
   return 2;
 }
 

@@ -17,6 +17,7 @@ int run_board(const Args& args);     // arpipe board FILE --out BOARD.png [--dpi
 int run_calib(const Args& args);
 int run_bench(const Args& args);       // arpipe bench blur [...]
 int run_sun(const Args& args);  // arpipe sun --lat .. --lon .. --time ISO8601
+int run_bench_shadows(const Args& args);  // arpipe bench shadows [--frames N] [--scenes DIR]
 int run_bench_blur(const Args& args);  // arpipe bench blur [--capture DIR | --scene FILE] [--out DIR] ...     // arpipe calib (--images GLOB | --recording DIR) --board FILE --out FILE ...
 
 }  // namespace arpipe

@@ -24,6 +24,8 @@ commands:
   bench blur [--capture DIR | --scene FILE] [--out DIR] [--frames N] [--reference-samples N]
                                      motion-blur methods: time against error (PSNR, SSIM)
                                      vs the converged reference and the simulator's truth
+  bench shadows [--frames N]         shadow methods and map sizes: time against the error of
+                                     the shadow on the ground vs the simulator's ray tracing
   sun --lat DEG --lon DEG --time ISO8601 [--alt M] [--delta-t S] [--pressure MBAR] [--temperature C]
       [--heading DEG] [--declination DEG] [--algorithm spa|psa|both]
                                      the sun's azimuth, elevation and direction (ENU, anchor
