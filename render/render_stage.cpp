@@ -11,6 +11,7 @@
 #include <numbers>
 #include <optional>
 
+#include "core/light/sh9.h"
 #include "core/log.h"
 #include "core/pipeline/monotonic_clock.h"
 #include "render/gl_error.h"
@@ -259,13 +260,15 @@ Lighting RenderStage::frame_lighting(const FrameContext& ctx, double& angular_di
     lighting.color = (1 / pi) * light.lights.front().irradiance;
     angular_diameter_rad = light.lights.front().angular_diameter_rad;
   }
+  // Further lights have no shadow map: they join the ambient light as the SH of a light from
+  // their direction (radiance coefficients E * Y_i(d)), unshadowed.
+  ShRgb9 radiance_sh = light.ambient_sh;
+  for (size_t k = 1; k < light.lights.size(); ++k)
+    sh9_add_sample(radiance_sh, light.lights[k].direction_world, light.lights[k].irradiance, 1.0);
   for (size_t i = 0; i < 9; ++i) {
     const size_t band = i == 0 ? 0 : (i < 4 ? 1 : 2);
-    lighting.ambient_sh[i] = kIrradianceOverPi[band] * light.ambient_sh[i];
+    lighting.ambient_sh[i] = kIrradianceOverPi[band] * radiance_sh[i];
   }
-  // Further lights have no shadow map: they light the objects as ambient does (their irradiance
-  // on a surface facing them, spread by the SH of a single direction would be finer; see the note).
-  for (size_t k = 1; k < light.lights.size(); ++k) lighting.ambient = lighting.ambient + (0.25 / pi) * light.lights[k].irradiance;
   const double exposure_s = 1e-9 * double(ctx.camera.meta.exposure_ns);
   lighting.exposure_scale = exposure_s > 0 ? exposure_s * ctx.camera.meta.total_gain() : 1.0;
   return lighting;
