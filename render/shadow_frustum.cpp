@@ -54,10 +54,9 @@ std::array<float, 4> ShadowFrustum::depth_plane() const {
 std::array<float, 16> ShadowFrustum::clip_from_world() const {
   std::array<float, 16> m{};
   if (local) {
-    // clip = (l.x / tan, l.y / tan, 2 depth - 1 times l.z, l.z) with l = R (world - position);
-    // the caster pass writes its own linear depth, so clip z only has to stay inside [-w, w].
+    // clip = (l.x / tan, l.y / tan, 0, l.z) with l = R (world - position): the caster pass
+    // writes its own linear depth (depth_plane), so clip z only has to stay inside [-w, w].
     const Vec3 t = mat_mul(R_light_world, light_position);
-    const std::array<float, 4> plane = depth_plane();
     for (size_t col = 0; col < 3; ++col) {
       m[col * 4 + 0] = float(R_light_world[0][col] / tan_half_angle);
       m[col * 4 + 1] = float(R_light_world[1][col] / tan_half_angle);
@@ -66,10 +65,6 @@ std::array<float, 16> ShadowFrustum::clip_from_world() const {
     m[12] = float(-t[0] / tan_half_angle);
     m[13] = float(-t[1] / tan_half_angle);
     m[15] = float(-t[2]);
-    // clip z = w * (2 depth - 1) is quadratic in the point; a fixed mid value keeps every
-    // fragment inside the clip volume instead (near/far clipping is not needed: the range is fitted).
-    (void)plane;
-    m[2] = m[6] = m[10] = m[14] = 0;
     return m;
   }
   // clip = 2 * map_coordinates - 1, written as a matrix (column-major: m[col * 4 + row]).
