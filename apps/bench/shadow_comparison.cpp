@@ -119,32 +119,28 @@ ShadowComparison compare_shadow(const std::filesystem::path& scenes_dir, const S
   }();
   Frame white = Frame::allocate(PixelFormat::RGB24, camera->width(), camera->height());
   std::fill(white.data.begin(), white.data.end(), uint8_t{255});
+  // One frame of the stages under a config, from the scene's camera pose.
+  const auto draw = [&](const Config& with) {
+    for (auto& stage : stages) stage->configure(with);
+    FrameContext frame;
+    frame.camera = white;
+    frame.camera_model = camera;
+    frame.pose.state = TrackState::Tracking;
+    frame.pose.T_cam_world = setup.camera;
+    for (auto& stage : stages) stage->process(frame);
+    return frame;
+  };
   std::vector<double> shadow_ms, render_ms;
   FrameContext ctx;
   for (int i = 0; i < std::max(1, frames); ++i) {
-    const Config& now = (i % 2 == 0) ? config : turned;
-    for (auto& stage : stages) stage->configure(now);
-    ctx = FrameContext{};
-    ctx.camera = white;
-    ctx.camera_model = camera;
-    ctx.pose.state = TrackState::Tracking;
-    ctx.pose.T_cam_world = setup.camera;
-    for (auto& stage : stages) stage->process(ctx);
+    ctx = draw(i % 2 == 0 ? config : turned);
     for (const StageTiming& t : ctx.timings) {
       if (t.stage == "shadow" && t.skipped.empty()) shadow_ms.push_back(t.ms);
       if (t.stage == "render") render_ms.push_back(t.ms);
     }
   }
   // The last frame must be the unturned light, which the truth has.
-  if (frames % 2 == 0) {
-    for (auto& stage : stages) stage->configure(config);
-    ctx = FrameContext{};
-    ctx.camera = white;
-    ctx.camera_model = camera;
-    ctx.pose.state = TrackState::Tracking;
-    ctx.pose.T_cam_world = setup.camera;
-    for (auto& stage : stages) stage->process(ctx);
-  }
+  if (frames % 2 == 0) ctx = draw(config);
   const ShadowTruth& t = shadow_truth(scenes_dir, setup);
   ShadowComparison c;
   c.shadow_ms = median(shadow_ms);
