@@ -240,7 +240,7 @@ namespace arpipe {
 Lighting RenderStage::frame_lighting(const FrameContext& ctx, double& angular_diameter_rad) const {
   Lighting lighting;
   const LightEstimate& light = ctx.light;
-  if (!light.scene_linear || light.state == LightState::None || light.state == LightState::Fixed) {
+  if (!light.scene_linear || light.state == LightState::None) {
     lighting.direction = settings_.light_direction;
     lighting.color = settings_.light_color;
     lighting.ambient = settings_.ambient;

@@ -4,7 +4,6 @@ namespace arpipe {
 
 std::string_view light_state_name(LightState state) {
   switch (state) {
-    case LightState::Fixed: return "fixed";
     case LightState::Estimated: return "estimated";
     case LightState::Held: return "held";
     case LightState::NoDirect: return "no-direct";

@@ -32,7 +32,6 @@ struct DirectionalLight {
 using ShRgb9 = std::array<Vec3, 9>;
 
 enum class LightState {
-  Fixed,       // from the config (render.light_*), display-referred: not scaled by exposure
   Estimated,   // measured on this frame (probe) or computed for its time (sun)
   Held,        // not measurable on this frame (probe out of view, clipped, ...): the last estimate
   NoDirect,    // no direct light (the sun is below the horizon): ambient only, no shadow pass
@@ -45,7 +44,7 @@ struct LightEstimate {
   std::string source = "fixed";          // "fixed", "mirror-probe", "diffuse-probe" or "sun"
   std::vector<DirectionalLight> lights;  // strongest first
   ShRgb9 ambient_sh{};                   // the light not in `lights`
-  bool scene_linear = false;             // units as above; false: display-referred (Fixed)
+  bool scene_linear = false;             // units as above (false: nothing estimated yet)
   double confidence = 0;                 // [0, 1]: how far the estimate can be trusted
   int frames_since_measured = 0;         // Held: frames since the last measurement
   std::string note;                      // why Held / NoDirect / low confidence, for the results
