@@ -12,6 +12,8 @@ pkg_check_modules(SYSTEMD REQUIRED IMPORTED_TARGET libsystemd)
 pkg_check_modules(EGL REQUIRED IMPORTED_TARGET egl)
 pkg_check_modules(GLES REQUIRED IMPORTED_TARGET glesv2)
 pkg_check_modules(GEOGRAPHICLIB REQUIRED IMPORTED_TARGET geographiclib)  # sun direction in local East-North-Up
+pkg_check_modules(LIBCAMERA REQUIRED IMPORTED_TARGET libcamera)  # live cameras behind an ISP (Raspberry Pi)
+pkg_check_modules(TURBOJPEG REQUIRED IMPORTED_TARGET libturbojpeg)  # MJPEG from UVC webcams
 
 # mrcal ships no pkg-config or CMake file; -lmrcal pulls in libdogleg and CHOLMOD.
 find_library(MRCAL_LIBRARY mrcal REQUIRED)

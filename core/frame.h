@@ -30,6 +30,10 @@ struct FrameMetadata {
   int64_t raw_timestamp_ns = 0;     // the source's timestamp as it gave it
   TimestampMeaning raw_timestamp_meaning = TimestampMeaning::StartOfExposure;
   int64_t timestamp_offset_ns = 0;  // per-camera offset applied while normalising
+  // What the camera's own processing measured, when it says (libcamera's Lux and
+  // ColourTemperature); 0 when unknown.
+  double lux = 0;
+  double colour_temperature_k = 0;
 
   // Middle of the exposure of the middle row: where a single pose for the frame belongs.
   int64_t exposure_mid_ns() const { return exposure_start_ns + (exposure_ns + readout_ns) / 2; }

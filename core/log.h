@@ -16,6 +16,7 @@ void write(Level level, std::string_view message);
 
 template <typename... Args> void error(fmt::format_string<Args...> f, Args&&... a) { write(Level::Error, fmt::format(f, std::forward<Args>(a)...)); }
 template <typename... Args> void warn(fmt::format_string<Args...> f, Args&&... a) { write(Level::Warning, fmt::format(f, std::forward<Args>(a)...)); }
+template <typename... Args> void notice(fmt::format_string<Args...> f, Args&&... a) { write(Level::Notice, fmt::format(f, std::forward<Args>(a)...)); }
 template <typename... Args> void info(fmt::format_string<Args...> f, Args&&... a) { write(Level::Info, fmt::format(f, std::forward<Args>(a)...)); }
 template <typename... Args> void debug(fmt::format_string<Args...> f, Args&&... a) { write(Level::Debug, fmt::format(f, std::forward<Args>(a)...)); }
 

@@ -11,6 +11,8 @@ packages=(
   libmrgingham-dev libeigen3-dev libsuitesparse-dev
   libtomlplusplus-dev nlohmann-json3-dev libsystemd-dev libfmt-dev
   libgeographiclib-dev
+  # live cameras: libcamera (ISP pipelines, Raspberry Pi), libjpeg-turbo (MJPEG from UVC webcams)
+  libcamera-dev libturbojpeg0-dev
   # render: EGL + GLES 3 on Mesa (llvmpipe when there is no GPU)
   libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri libgbm1
   libtinygltf-dev libembree-dev libstb-dev libpng-dev

@@ -16,7 +16,9 @@ int run_config(const Args& args);    // arpipe config --defaults | --check FILE
 int run_board(const Args& args);     // arpipe board FILE --out BOARD.png [--dpi N]
 int run_calib(const Args& args);
 int run_bench(const Args& args);       // arpipe bench blur [...]
-int run_sun(const Args& args);  // arpipe sun --lat .. --lon .. --time ISO8601
+int run_sun(const Args& args);
+int run_cameras(const Args& args);  // arpipe cameras [DEVICE]...
+int run_record(const Args& args);   // arpipe record --camera CAMERA --out DIR [--frames N | --seconds S] ...  // arpipe sun --lat .. --lon .. --time ISO8601
 int run_bench_shadows(const Args& args);  // arpipe bench shadows [--frames N] [--scenes DIR]
 int run_bench_blur(const Args& args);  // arpipe bench blur [--capture DIR | --scene FILE] [--out DIR] ...     // arpipe calib (--images GLOB | --recording DIR) --board FILE --out FILE ...
 

@@ -30,6 +30,12 @@ commands:
       [--heading DEG] [--declination DEG] [--algorithm spa|psa|both]
                                      the sun's azimuth, elevation and direction (ENU, anchor
                                      frame) for a place and time (NREL SPA and/or PSA)
+  cameras [DEVICE]...                every camera V4L2 and libcamera see: formats, sizes, rates,
+                                     controls, and the config key that selects it
+  record --camera CAMERA --out DIR [--frames N | --seconds S] [--width W --height H] [--fps F]
+         [--format F] [--exposure-us US] [--gain G] [--camera-model FILE] [--config FILE]
+                                     record a live camera (CAMERA: /dev/videoN, v4l2:PATH or
+                                     libcamera:ID|INDEX) with its exposure metadata
   config --defaults                  print a config with every key at its default
   config --check FILE                validate a config file
 )";
@@ -52,6 +58,8 @@ int main(int argc, char** argv) {
   if (command == "board") return arpipe::run_board(args);
   if (command == "bench") return arpipe::run_bench(args);
   if (command == "sun") return arpipe::run_sun(args);
+  if (command == "cameras") return arpipe::run_cameras(args);
+  if (command == "record") return arpipe::run_record(args);
   std::fprintf(stderr, "arpipe: unknown command '%s'\n%s", command.c_str(), kUsage);
   return 2;
 }

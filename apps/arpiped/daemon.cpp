@@ -76,7 +76,7 @@ int run_daemon(const DaemonOptions& options) {
     log::error("{}", e.what());
     return 2;
   }
-  log::info("running {} with {}", options.config_path.string(), config.source.path.string());
+  log::info("running {} with {}", options.config_path.string(), runner->source_description());
   systemd.ready();
 
   const int64_t watchdog_ns = systemd.watchdog_interval_ns();
@@ -100,14 +100,16 @@ int run_daemon(const DaemonOptions& options) {
     const int64_t now = monotonic_now_ns();
     if (now - last_status_ns > 2'000'000'000) {
       const auto m = runner->metrics();
-      systemd.status(fmt::format("{} frames, {:.1f} frames/s, tracked {}, predicted {}, lost {}, drops {}",
+      const std::string health = runner->source_health();
+      systemd.status(fmt::format("{} frames, {:.1f} frames/s, tracked {}, predicted {}, lost {}, drops {}{}{}",
                                  m.frames_out, m.fps(), m.frames_tracked, m.frames_predicted, m.frames_lost,
-                                 m.sequence_gaps + m.queue_drops));
+                                 m.sequence_gaps + m.queue_drops, health.empty() ? "" : "; camera: ", health));
       last_status_ns = now;
     }
   }
   runner->wait();
   log::info("{}", describe_metrics(runner->metrics()));
+  if (const std::string health = runner->source_health(); !health.empty()) log::info("camera: {}", health);
   return 0;
 }
 

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include "capture/live/live_source.h"
 #include "capture/replay_source.h"
 #include "capture/sinks/png_sink.h"
 #include "capture/sinks/recording_sink.h"
@@ -17,8 +18,9 @@ namespace arpipe {
 
 std::unique_ptr<FrameSource> make_source(const Config& config) {
   if (config.source.type == "replay") return std::make_unique<ReplaySource>(config.source);
-  throw ConfigError(fmt::format("{}: source.type \"{}\" is not supported (expected \"replay\")", config.file.string(),
-                                config.source.type));
+  if (config.source.type == "v4l2" || config.source.type == "libcamera") return make_live_source(config.source);
+  throw ConfigError(fmt::format("{}: source.type \"{}\" is not supported (expected \"replay\", \"v4l2\" or \"libcamera\")",
+                                config.file.string(), config.source.type));
 }
 
 std::vector<std::unique_ptr<FrameSink>> make_sinks(const Config& config) {

@@ -221,6 +221,9 @@ std::string encode_frame_record(const FrameRecord& r) {
       {"raw_timestamp_meaning", std::string(timestamp_meaning_name(m.raw_timestamp_meaning))},
       {"timestamp_offset_ns", m.timestamp_offset_ns},
   };
+  // What the camera measured, only when it said (libcamera's Lux and ColourTemperature).
+  if (m.lux > 0) j["lux"] = m.lux;
+  if (m.colour_temperature_k > 0) j["colour_temperature_k"] = m.colour_temperature_k;
   return j.dump();
 }
 
@@ -247,6 +250,11 @@ FrameRecord decode_frame_record(const std::string& line, const std::string& wher
   if (!timestamp_meaning_from_name(meaning, m.raw_timestamp_meaning))
     throw RecordingError(fmt::format("{}: raw_timestamp_meaning is \"{}\", expected {}", where, meaning, meanings));
   m.timestamp_offset_ns = get_signed(j, "timestamp_offset_ns", where, "integer nanoseconds");
+  if (j.contains("lux")) m.lux = get_double(j, "lux", where, "the scene's illuminance in lux");
+  if (j.contains("colour_temperature_k"))
+    m.colour_temperature_k = get_double(j, "colour_temperature_k", where, "a colour temperature in kelvin");
+  if (m.lux < 0 || m.colour_temperature_k < 0)
+    throw RecordingError(fmt::format("{}: lux and colour_temperature_k must not be negative", where));
   if (m.exposure_ns < 0 || m.readout_ns < 0 || m.frame_duration_ns < 0)
     throw RecordingError(fmt::format("{}: exposure_ns, readout_ns and frame_duration_ns must not be negative", where));
   return r;

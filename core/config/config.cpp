@@ -233,13 +233,38 @@ const auto non_negative = [](double v) { return v >= 0; };
 
 void read_source(const ConfigReader& r, const toml::table& t, SourceConfig& out) {
   const std::string p = "source.";
-  r.check_keys(t, p, {"type", "path", "pacing", "loop", "timestamp_offset_ns", "camera_model"}, "[source]");
-  r.read(t, p, "type", out.type, {"replay"});
+  r.check_keys(t, p,
+               {"type", "path", "pacing", "loop", "timestamp_offset_ns", "camera_model", "device", "camera", "role",
+                "width", "height", "fps", "pixel_format", "buffers", "exposure_us", "gain", "gain_unity",
+                "timestamp_meaning", "readout_ns", "frame_timeout_ms", "reconnect_min_ms", "reconnect_max_ms"},
+               "[source]");
+  r.read(t, p, "type", out.type, {"replay", "v4l2", "libcamera"});
   r.read(t, p, "path", out.path);
   r.read(t, p, "pacing", out.pacing, {"timestamps", "fast"});
   r.read(t, p, "loop", out.loop);
   r.read(t, p, "timestamp_offset_ns", out.timestamp_offset_ns);
   r.read(t, p, "camera_model", out.camera_model);
+  r.read(t, p, "device", out.device);
+  r.read(t, p, "camera", out.camera);
+  r.read(t, p, "role", out.role, {"video", "viewfinder", "still", "raw"});
+  r.read(t, p, "width", out.width, 0, 16384);
+  r.read(t, p, "height", out.height, 0, 16384);
+  r.read(t, p, "fps", out.fps, non_negative, "a number >= 0");
+  r.read(t, p, "pixel_format", out.pixel_format, {"auto", "YUYV", "NV12", "RGB24", "GREY", "MJPG"});
+  r.read(t, p, "buffers", out.buffers, 4, 32);  // fewer than 4 starves the driver while one is being converted
+  r.read(t, p, "exposure_us", out.exposure_us, 0, 60'000'000);
+  r.read(t, p, "gain", out.gain, non_negative, "a number >= 0");
+  r.read(t, p, "gain_unity", out.gain_unity, positive, "a number > 0");
+  r.read(t, p, "timestamp_meaning", out.timestamp_meaning, {"auto", "start-of-exposure", "end-of-frame"});
+  r.read(t, p, "readout_ns", out.readout_ns, 0, 1'000'000'000);
+  r.read(t, p, "frame_timeout_ms", out.frame_timeout_ms, 1, 600'000);
+  r.read(t, p, "reconnect_min_ms", out.reconnect_min_ms, 1, 600'000);
+  r.read(t, p, "reconnect_max_ms", out.reconnect_max_ms, 1, 3'600'000);
+  if (out.reconnect_max_ms < out.reconnect_min_ms) {
+    const toml::node* node = t.get("reconnect_max_ms") ? t.get("reconnect_max_ms") : t.get("reconnect_min_ms");
+    r.fail_got(*node, p + "reconnect_max_ms", fmt::format("at least reconnect_min_ms ({})", out.reconnect_min_ms),
+               fmt::format("{}", out.reconnect_max_ms));
+  }
 }
 
 void read_track(const ConfigReader& r, const toml::table& t, TrackConfig& out) {
@@ -646,13 +671,31 @@ std::string default_config_toml() {
   out += "# Units: metres, nanoseconds, and degrees for angles (the code works in radians).\n";
 
   out += "\n[source]\n";
-  entry("type", s(d.source.type), "\"replay\" (live sources come later)");
+  entry("type", s(d.source.type), "\"replay\", \"v4l2\" or \"libcamera\"");
   entry("path", s(d.source.path.string()), "replay: the recording directory");
-  entry("pacing", s(d.source.pacing), "\"timestamps\" (real time) or \"fast\"");
+  entry("pacing", s(d.source.pacing), "replay: \"timestamps\" (real time) or \"fast\"");
   entry("loop", b(d.source.loop), "replay: start again at the end");
   entry("timestamp_offset_ns", fmt::format("{}", d.source.timestamp_offset_ns),
         "added to every exposure start of this camera");
-  entry("camera_model", s(d.source.camera_model.string()), "a .cameramodel to use instead of the recording's");
+  entry("camera_model", s(d.source.camera_model.string()),
+        "a .cameramodel to use instead of the recording's (live: needed to track)");
+  entry("device", s(d.source.device), "v4l2: /dev/videoN or a /dev/v4l/by-id or by-path link");
+  entry("camera", s(d.source.camera), "libcamera: a camera id or index (\"\": the first)");
+  entry("role", s(d.source.role), "libcamera stream role: video, viewfinder, still, raw");
+  entry("width", fmt::format("{}", d.source.width), "live: 0 = the camera's first size");
+  entry("height", fmt::format("{}", d.source.height));
+  entry("fps", format_toml_float(d.source.fps), "live: 0 = the camera's default rate");
+  entry("pixel_format", s(d.source.pixel_format), "YUYV, NV12, RGB24, GREY, MJPG (decoded to RGB24) or auto");
+  entry("buffers", fmt::format("{}", d.source.buffers), "capture buffers, 4 to 32");
+  entry("exposure_us", fmt::format("{}", d.source.exposure_us), "manual exposure; 0 = auto exposure");
+  entry("gain", format_toml_float(d.source.gain), "manual analogue gain (1 = unity); 0 = auto");
+  entry("gain_unity", format_toml_float(d.source.gain_unity), "v4l2: the gain control value that means gain 1");
+  entry("timestamp_meaning", s(d.source.timestamp_meaning),
+        "v4l2: auto (the driver's flag), start-of-exposure or end-of-frame");
+  entry("readout_ns", fmt::format("{}", d.source.readout_ns), "rolling-shutter readout time; 0 = global shutter");
+  entry("frame_timeout_ms", fmt::format("{}", d.source.frame_timeout_ms), "a frame later than this is a timeout");
+  entry("reconnect_min_ms", fmt::format("{}", d.source.reconnect_min_ms), "first retry after the camera went away");
+  entry("reconnect_max_ms", fmt::format("{}", d.source.reconnect_max_ms), "retries back off up to this");
 
   out += "\n[track]\n";
   entry("enabled", b(d.track.enabled));

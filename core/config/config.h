@@ -19,12 +19,32 @@ class ConfigError : public std::runtime_error {
 };
 
 struct SourceConfig {
-  std::string type = "replay";          // "replay" (more sources come with the live-capture issue)
+  std::string type = "replay";          // "replay", "v4l2" or "libcamera"
   std::filesystem::path path;           // replay: the recording directory
   std::string pacing = "timestamps";    // replay: "timestamps" (real time) or "fast"
   bool loop = false;                    // replay: start again at the end (soak tests)
   int64_t timestamp_offset_ns = 0;      // added to every exposure_start_ns of this camera
-  std::filesystem::path camera_model;   // overrides the recording's camera model when set
+  std::filesystem::path camera_model;   // overrides the recording's camera model; live: required to track
+
+  // Live cameras (v4l2, libcamera). 0 or "auto": whatever the camera offers first.
+  std::string device;                   // v4l2: /dev/videoN or a /dev/v4l/by-id|by-path link
+  std::string camera;                   // libcamera: camera id, or its index in the list ("" = first)
+  std::string role = "video";           // libcamera stream role: video, viewfinder, still, raw
+  int width = 0;
+  int height = 0;
+  double fps = 0;
+  std::string pixel_format = "auto";    // YUYV, NV12, RGB24, GREY, MJPG (v4l2: decoded to RGB24), auto
+  int buffers = 4;                      // capture buffers (at least 4)
+  int64_t exposure_us = 0;              // manual exposure; 0: auto exposure
+  double gain = 0;                      // manual analogue gain (1 = unity); 0: auto
+  double gain_unity = 100;              // v4l2: the gain control's value that means gain 1
+  // v4l2: what the buffer timestamps mean when the driver does not say (no TSTAMP_SRC flag), or
+  // "auto" to take the driver's flag (end-of-frame when it gives none).
+  std::string timestamp_meaning = "auto";  // auto, start-of-exposure, end-of-frame
+  int64_t readout_ns = 0;               // rolling-shutter readout (first to last row); 0: global
+  int64_t frame_timeout_ms = 1000;      // a frame later than this is a timeout (counted)
+  int64_t reconnect_min_ms = 100;       // first retry after a camera disappeared
+  int64_t reconnect_max_ms = 5000;      // retries back off up to this
 
   bool operator==(const SourceConfig&) const = default;
 };

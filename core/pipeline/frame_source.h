@@ -28,6 +28,9 @@ class FrameSource {
   virtual SourceStatus next(Frame& frame) = 0;
   // Asks a blocked next() to return soon (from another thread).
   virtual void interrupt() {}
+  // What a live source has lived through ("disconnects 1, reconnects 1, timeouts 2"), for the
+  // daemon's status; empty when there is nothing to say. Thread-safe.
+  virtual std::string health() const { return {}; }
 };
 
 }  // namespace arpipe

@@ -40,6 +40,8 @@ class PipelineRunner {
   bool reconfigure(const Config& config, std::string& error);
 
   PipelineMetrics metrics() const;
+  std::string source_description() const { return source_->describe(); }
+  std::string source_health() const { return source_->health(); }
   // False when the processing or the sink thread has been inside one frame for longer than
   // max_stall_ns (a hung stage or disk: the watchdog stops pinging, so systemd restarts the daemon).
   // Idle waiting is healthy.

@@ -59,6 +59,9 @@ inline Frame random_frame(PixelFormat format, int width, int height, size_t byte
   f.meta.raw_timestamp_ns = f.meta.exposure_start_ns + 20'000'000;
   f.meta.raw_timestamp_meaning = TimestampMeaning::EndOfFrame;
   f.meta.timestamp_offset_ns = -1'234;
+  // Every other frame says what the camera measured (libcamera's Lux and ColourTemperature).
+  f.meta.lux = index % 2 ? 0.0 : 312.5 + double(index);
+  f.meta.colour_temperature_k = index % 2 ? 0.0 : 4650.0;
   return f;
 }
 

@@ -26,6 +26,8 @@ void expect_same_metadata(const FrameMetadata& a, const FrameMetadata& b) {
   EXPECT_EQ(a.raw_timestamp_ns, b.raw_timestamp_ns);
   EXPECT_EQ(a.raw_timestamp_meaning, b.raw_timestamp_meaning);
   EXPECT_EQ(a.timestamp_offset_ns, b.timestamp_offset_ns);
+  EXPECT_EQ(a.lux, b.lux);
+  EXPECT_EQ(a.colour_temperature_k, b.colour_temperature_k);
 }
 
 // Poses pass through a rotation vector printed exactly, then Rodrigues: a few ulps of drift.

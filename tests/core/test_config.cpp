@@ -266,7 +266,14 @@ TEST(Config, OutOfRangeValuesSayWhatWasExpected) {
   expect_error("[render]\nlens_canvas_scale = 0.5\n",
                {"test.toml:2:21:", "'render.lens_canvas_scale' expected a number in [1, 4], got 0.5"});
   expect_error("[render]\nlens_canvas_scale = 8\n", {"'render.lens_canvas_scale' expected a number in [1, 4], got 8.0"});
-  expect_error("[source]\ntype = \"v4l2\"\n", {"test.toml:2:8:", "'source.type' expected one of \"replay\""});
+  expect_error("[source]\ntype = \"gstreamer\"\n",
+               {"test.toml:2:8:", "'source.type' expected one of \"replay\", \"v4l2\", \"libcamera\""});
+  expect_error("[source]\nbuffers = 2\n", {"test.toml:2:11:", "'source.buffers' expected an integer in [4, 32], got 2"});
+  expect_error("[source]\npixel_format = \"H264\"\n", {"'source.pixel_format' expected one of \"auto\"", "got \"H264\""});
+  expect_error("[source]\ntimestamp_meaning = \"middle\"\n",
+               {"'source.timestamp_meaning' expected one of \"auto\", \"start-of-exposure\", \"end-of-frame\""});
+  expect_error("[source]\nreconnect_min_ms = 500\nreconnect_max_ms = 100\n",
+               {"test.toml:3:", "'source.reconnect_max_ms' expected at least reconnect_min_ms (500), got 100"});
   expect_error("[source]\npacing = \"slow\"\n", {"'source.pacing' expected one of \"timestamps\", \"fast\""});
   expect_error("[track]\nfamily = \"tag36h12\"\n",
                {"test.toml:2:10:", "'track.family' expected one of", "tagCircle49h12", "tag36h10", "got \"tag36h12\""});

@@ -93,8 +93,9 @@ class ChildProcess {
 
 // Runs to completion; returns the exit code, or -(signal) if it died of a signal, or -1000 on timeout.
 inline int run_to_exit(const std::filesystem::path& program, const std::vector<std::string>& args,
-                       const std::filesystem::path& log_dir, std::string* stderr_text = nullptr) {
-  ChildProcess child(program, args, log_dir);
+                       const std::filesystem::path& log_dir, std::string* stderr_text = nullptr,
+                       const std::vector<std::string>& env = {}) {
+  ChildProcess child(program, args, log_dir, env);
   const int status = child.wait();
   if (stderr_text) *stderr_text = child.stderr_text();
   if (status == -1) return -1000;

@@ -1,0 +1,156 @@
+// The V4L2 capture path's cost per frame against a plain memory copy of the same frame, and the
+// latency from a frame's exposure end to its hand-off, measured through the V4L2 stand-in
+// (tests/v4l2_standin) serving a recording. Usage: capture_path [RECORDING] [--frames N]
+//
+// Per format the camera sends: the source's own work per frame, split into the buffer exchange
+// (DQBUF + QBUF: a syscall pair on hardware; through the stand-in, a function call plus whatever
+// frame it prepares then) and the copy or decode into the Frame with its metadata; the hand-off
+// into the pipeline's queue; and a memcpy of the same bytes, timed in the same run.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "capture/live/live_source.h"
+#include "capture/recording/recording_reader.h"
+#include "core/log.h"
+#include "core/pipeline/bounded_queue.h"
+#include "core/pipeline/monotonic_clock.h"
+#include "v4l2_standin.h"
+
+namespace fs = std::filesystem;
+using namespace arpipe;
+
+namespace {
+
+constexpr const char* kDevice = "/dev/video-arpipe-bench";
+
+void load_standin(const fs::path& dir, const fs::path& recording, const std::string& keys) {
+  const fs::path config = dir / "standin.toml";
+  std::ofstream(config) << "[[device]]\npath = \"" << kDevice << "\"\nrecording = \"" << recording.string() << "\"\n"
+                        << keys << "\n";
+  char error[512] = {};
+  if (arpipe_v4l2_standin_load(config.c_str(), error, sizeof error) != 0)
+    throw std::runtime_error(fmt::format("stand-in: {}", error));
+}
+
+SourceConfig source_config(const std::string& format) {
+  SourceConfig c;
+  c.type = "v4l2";
+  c.device = kDevice;
+  c.pixel_format = format;
+  return c;
+}
+
+// A memcpy of `bytes` into a buffer of its own, as a plain copy of the frame would be: ns per copy.
+double memcpy_ns(size_t bytes, int repeats) {
+  std::vector<uint8_t> from(bytes, 1), to(bytes);
+  for (int i = 0; i < 3; ++i) std::memcpy(to.data(), from.data(), bytes);  // warm the pages
+  const int64_t start = monotonic_now_ns();
+  for (int i = 0; i < repeats; ++i) {
+    from[size_t(i) % bytes] = uint8_t(i);
+    std::memcpy(to.data(), from.data(), bytes);
+  }
+  const int64_t end = monotonic_now_ns();
+  if (to[0] == 42) std::puts("");  // keep the copies
+  return double(end - start) / repeats;
+}
+
+struct Row {
+  std::string format;
+  size_t camera_bytes = 0, frame_bytes = 0;
+  double dequeue_us = 0, convert_us = 0, handoff_us = 0, memcpy_us = 0;
+};
+
+Row measure(const fs::path& dir, const fs::path& recording, const std::string& camera_format, int frames) {
+  load_standin(dir, recording, fmt::format("pacing = \"fast\"\nformats = [\"{}\"]\nloop = true", camera_format));
+  auto source = make_live_source(source_config(camera_format == "native" ? "auto" : camera_format));
+  BoundedQueue<Frame> queue(4, OverflowPolicy::DropOldest);
+  Row row;
+  row.format = source->format().camera_format;
+  for (int i = 0; i < 10; ++i) {  // warm-up: first buffers, allocator, decoder
+    Frame frame;
+    while (source->next(frame) != SourceStatus::Frame) {
+    }
+  }
+  const StreamCounters before = source->counters().stream;
+  int64_t handoff = 0;
+  for (int i = 0; i < frames; ++i) {
+    Frame frame;
+    while (source->next(frame) != SourceStatus::Frame) {
+    }
+    row.frame_bytes = frame.data.size();
+    const int64_t t0 = monotonic_now_ns();
+    queue.push(std::move(frame));  // what the capture thread does with it; the pop is the next thread's
+    const int64_t t1 = monotonic_now_ns();
+    handoff += t1 - t0;
+    queue.pop();
+  }
+  const StreamCounters after = source->counters().stream;
+  row.dequeue_us = double(after.dequeue_ns - before.dequeue_ns) / frames * 1e-3;
+  row.convert_us = double(after.convert_ns - before.convert_ns) / frames * 1e-3;
+  row.handoff_us = double(handoff) / frames * 1e-3;
+  row.memcpy_us = memcpy_ns(row.frame_bytes, frames) * 1e-3;
+  arpipe_v4l2_standin_unload();
+  return row;
+}
+
+// Real-time pacing with live timestamps: each frame falls due at its exposure end, on this clock.
+std::vector<double> latencies_ms(const fs::path& dir, const fs::path& recording, int frames) {
+  load_standin(dir, recording, "pacing = \"realtime\"\ntimestamps = \"live\"\ntimestamp_source = \"eof\"\nloop = true");
+  auto source = make_live_source(source_config("auto"));
+  std::vector<double> ms;
+  while (int(ms.size()) < frames) {
+    Frame frame;
+    if (source->next(frame) != SourceStatus::Frame) continue;
+    const int64_t handed_off = monotonic_now_ns();
+    const auto& m = frame.meta;
+    ms.push_back(double(handed_off - (m.exposure_start_ns + m.exposure_ns + m.readout_ns)) * 1e-6);
+  }
+  arpipe_v4l2_standin_unload();
+  std::sort(ms.begin(), ms.end());
+  return ms;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  log::set_program_name("capture_path");
+  log::set_max_level(log::Level::Warning);
+  fs::path recording = fs::path(ARPIPE_BINARY_DIR) / "default-capture";
+  int frames = 300;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--frames" && i + 1 < argc) frames = std::max(10, std::atoi(argv[++i]));
+    else recording = a;
+  }
+  try {
+    const fs::path dir = fs::temp_directory_path() / fmt::format("arpipe-capture-path-{}", getpid());
+    fs::create_directories(dir);
+    const RecordingReader reader(recording);
+    fmt::print("capture path through the V4L2 stand-in: {} ({}x{} {}), {} frames per format\n\n", recording.string(),
+               reader.info().width, reader.info().height, pixel_format_name(reader.info().pixel_format), frames);
+    fmt::print("| camera sends | frame bytes | DQBUF+QBUF µs | copy/decode µs | hand-off µs | memcpy µs | "
+               "(copy/decode + hand-off) / memcpy |\n|---|---:|---:|---:|---:|---:|---:|\n");
+    for (const char* format : {"YUYV", "GREY", "RGB24", "NV12", "MJPG"}) {
+      const Row r = measure(dir, recording, format, frames);
+      fmt::print("| {} | {} | {:.1f} | {:.1f} | {:.2f} | {:.1f} | {:.2f} |\n", r.format, r.frame_bytes, r.dequeue_us,
+                 r.convert_us, r.handoff_us, r.memcpy_us, (r.convert_us + r.handoff_us) / r.memcpy_us);
+    }
+    const auto ms = latencies_ms(dir, recording, std::min(frames, 90));
+    const auto at = [&](double q) { return ms[std::min(ms.size() - 1, size_t(q * double(ms.size())))]; };
+    fmt::print("\nexposure end to hand-off (real-time pacing, {} frames): median {:.3f} ms, p90 {:.3f} ms, max {:.3f} ms\n",
+               ms.size(), at(0.5), at(0.9), ms.back());
+    fs::remove_all(dir);
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "capture_path: %s\n", e.what());
+    return 1;
+  }
+}

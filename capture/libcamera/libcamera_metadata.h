@@ -1,0 +1,61 @@
+// libcamera's per-request metadata as plain optional values, and its mapping to DESIGN.md's
+// FrameMetadata. No libcamera types here, so the mapping is tested without a camera.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "core/frame.h"
+
+namespace arpipe {
+
+// What a completed request's metadata said; each value is absent when the pipeline did not report
+// it (UVC cameras under libcamera report little more than the timestamp).
+struct LibcameraRequestValues {
+  std::optional<int64_t> sensor_timestamp_ns;  // controls::SensorTimestamp
+  std::optional<int64_t> exposure_us;          // controls::ExposureTime
+  std::optional<double> analogue_gain;         // controls::AnalogueGain
+  std::optional<double> digital_gain;          // controls::DigitalGain
+  std::optional<int64_t> frame_duration_us;    // controls::FrameDuration
+  std::optional<double> lux;                   // controls::Lux
+  std::optional<double> colour_temperature_k;  // controls::ColourTemperature
+};
+
+// What the config says about this camera, used where the request says nothing.
+struct LibcameraTiming {
+  int64_t timestamp_offset_ns = 0;     // source.timestamp_offset_ns
+  int64_t readout_ns = 0;              // source.readout_ns (libcamera does not report it)
+  int64_t manual_exposure_us = 0;      // source.exposure_us; 0: auto
+  double manual_gain = 0;              // source.gain; 0: auto
+  int64_t nominal_frame_duration_ns = 0;  // from source.fps; 0: not configured
+};
+LibcameraTiming libcamera_timing(int64_t timestamp_offset_ns, int64_t readout_ns, int64_t exposure_us,
+                                 double gain, double fps);
+
+// Values the request lacked and the mapping filled in (bit flags).
+enum LibcameraMissing : unsigned {
+  kMissingNone = 0,
+  kMissingSensorTimestamp = 1u << 0,  // took the buffer's own timestamp
+  kMissingExposure = 1u << 1,         // took the manual exposure, else 0 (unknown)
+  kMissingAnalogueGain = 1u << 2,     // took the manual gain, else 1
+  kMissingDigitalGain = 1u << 3,      // took 1
+  kMissingFrameDuration = 1u << 4,    // took the nominal duration from fps, else 0 (unknown)
+};
+// "SensorTimestamp, ExposureTime" for the flags set; "" for none.
+std::string libcamera_missing_names(unsigned missing);
+
+struct LibcameraMapped {
+  FrameMetadata meta;
+  unsigned missing = kMissingNone;  // LibcameraMissing flags
+};
+
+// Maps one completed request. `sequence` is the buffer's sequence number (gaps are drops);
+// `buffer_timestamp_ns` is FrameBuffer::metadata().timestamp, used only when SensorTimestamp is
+// absent, and then with the meaning TimestampMeaning::Sensor, because libcamera documents it only
+// as "when the frame was captured". Lux and colour temperature stay 0 when absent (FrameMetadata's
+// "unknown").
+LibcameraMapped map_libcamera_metadata(const LibcameraRequestValues& values, uint64_t sequence,
+                                       int64_t buffer_timestamp_ns, const LibcameraTiming& timing);
+
+}  // namespace arpipe

@@ -1,0 +1,87 @@
+// The mapping of libcamera request metadata to FrameMetadata, against values worked out by hand
+// from the control definitions (µs for ExposureTime and FrameDuration, ns for SensorTimestamp).
+// All quantities are integers or exactly representable, so the comparisons are exact.
+#include <gtest/gtest.h>
+
+#include "capture/libcamera/libcamera_metadata.h"
+
+namespace arpipe {
+namespace {
+
+LibcameraRequestValues full_values() {
+  LibcameraRequestValues v;
+  v.sensor_timestamp_ns = 5'000'123'456'789;
+  v.exposure_us = 12'345;
+  v.analogue_gain = 2.5;
+  v.digital_gain = 1.25;
+  v.frame_duration_us = 33'333;
+  v.lux = 412.5;
+  v.colour_temperature_k = 5600;
+  return v;
+}
+
+TEST(LibcameraMetadata, EveryValuePresentMapsExactly) {
+  const auto timing = libcamera_timing(/*offset*/ -1'500'000, /*readout*/ 18'000'000, 0, 0, 30);
+  const auto r = map_libcamera_metadata(full_values(), 77, /*buffer timestamp*/ 999, timing);
+  EXPECT_EQ(r.missing, kMissingNone);
+  const FrameMetadata& m = r.meta;
+  EXPECT_EQ(m.sequence, 77u);
+  EXPECT_EQ(m.raw_timestamp_ns, 5'000'123'456'789);
+  EXPECT_EQ(m.raw_timestamp_meaning, TimestampMeaning::StartOfExposure);
+  // SensorTimestamp is the start of exposure: only the configured offset is added.
+  EXPECT_EQ(m.exposure_start_ns, 5'000'123'456'789 - 1'500'000);
+  EXPECT_EQ(m.timestamp_offset_ns, -1'500'000);
+  EXPECT_EQ(m.exposure_ns, 12'345'000);
+  EXPECT_EQ(m.readout_ns, 18'000'000);
+  EXPECT_EQ(m.frame_duration_ns, 33'333'000);  // the request's, not the nominal 33'333'333
+  EXPECT_EQ(m.analogue_gain, 2.5);
+  EXPECT_EQ(m.digital_gain, 1.25);
+  EXPECT_EQ(m.lux, 412.5);
+  EXPECT_EQ(m.colour_temperature_k, 5600);
+}
+
+TEST(LibcameraMetadata, MissingSensorTimestampFallsBackToTheBufferTimestampAsSensorTime) {
+  auto v = full_values();
+  v.sensor_timestamp_ns.reset();
+  const auto r = map_libcamera_metadata(v, 3, 7'000'000'000, libcamera_timing(250'000, 0, 0, 0, 0));
+  EXPECT_EQ(r.missing, kMissingSensorTimestamp);
+  EXPECT_EQ(r.meta.raw_timestamp_ns, 7'000'000'000);
+  EXPECT_EQ(r.meta.raw_timestamp_meaning, TimestampMeaning::Sensor);
+  // "Sensor" is treated as start of exposure plus the offset (core/frame.h).
+  EXPECT_EQ(r.meta.exposure_start_ns, 7'000'250'000);
+  EXPECT_EQ(libcamera_missing_names(r.missing), "SensorTimestamp");
+}
+
+TEST(LibcameraMetadata, MissingExposureAndGainTakeTheManualConfigValues) {
+  LibcameraRequestValues v;
+  v.sensor_timestamp_ns = 1'000;
+  const auto r = map_libcamera_metadata(v, 0, 0, libcamera_timing(0, 0, /*exposure_us*/ 8'000, /*gain*/ 4.0, /*fps*/ 50));
+  EXPECT_EQ(r.missing, kMissingExposure | kMissingAnalogueGain | kMissingDigitalGain | kMissingFrameDuration);
+  EXPECT_EQ(r.meta.exposure_ns, 8'000'000);
+  EXPECT_EQ(r.meta.analogue_gain, 4.0);
+  EXPECT_EQ(r.meta.digital_gain, 1.0);
+  EXPECT_EQ(r.meta.frame_duration_ns, 20'000'000);  // 1 s / 50
+  EXPECT_EQ(r.meta.exposure_start_ns, 1'000);
+  EXPECT_EQ(libcamera_missing_names(r.missing), "ExposureTime, AnalogueGain, DigitalGain, FrameDuration");
+}
+
+TEST(LibcameraMetadata, MissingValuesUnderAutoExposureAreUnknownOrUnity) {
+  LibcameraRequestValues v;  // nothing at all, as from a pipeline that reports nothing
+  const auto r = map_libcamera_metadata(v, 9, 42, libcamera_timing(0, 0, 0, 0, 0));
+  EXPECT_EQ(r.meta.exposure_ns, 0);        // unknown
+  EXPECT_EQ(r.meta.frame_duration_ns, 0);  // unknown
+  EXPECT_EQ(r.meta.analogue_gain, 1.0);
+  EXPECT_EQ(r.meta.digital_gain, 1.0);
+  EXPECT_EQ(r.meta.lux, 0.0);
+  EXPECT_EQ(r.meta.colour_temperature_k, 0.0);
+  EXPECT_EQ(r.meta.exposure_start_ns, 42);
+}
+
+TEST(LibcameraMetadata, TimingRoundsTheNominalFrameDuration) {
+  EXPECT_EQ(libcamera_timing(0, 0, 0, 0, 30).nominal_frame_duration_ns, 33'333'333);
+  EXPECT_EQ(libcamera_timing(0, 0, 0, 0, 29.97).nominal_frame_duration_ns, 33'366'700);  // 1e9/29.97 = 33366700.03
+  EXPECT_EQ(libcamera_timing(0, 0, -5, -1, -2).manual_exposure_us, 0);
+}
+
+}  // namespace
+}  // namespace arpipe

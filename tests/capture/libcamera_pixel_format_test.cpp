@@ -1,0 +1,53 @@
+// libcamera <-> arpipe pixel formats, checked against the DRM fourcc codes (drm_fourcc.h) and
+// their documented memory layouts, not against the code's own table.
+#include <gtest/gtest.h>
+
+#include <libcamera/formats.h>
+
+#include "capture/libcamera/libcamera_pixel_format.h"
+
+namespace arpipe {
+namespace {
+
+constexpr uint32_t fourcc(char a, char b, char c, char d) {
+  return uint32_t(uint8_t(a)) | uint32_t(uint8_t(b)) << 8 | uint32_t(uint8_t(c)) << 16 | uint32_t(uint8_t(d)) << 24;
+}
+
+TEST(LibcameraPixelFormat, Rgb24IsDrmBgr888) {
+  // DRM_FORMAT_BGR888 = 'BG24', "[23:0] B:G:R little endian": byte 0 is R, as arpipe's RGB24.
+  const auto f = libcamera_pixel_format(PixelFormat::RGB24);
+  EXPECT_EQ(f.fourcc(), fourcc('B', 'G', '2', '4'));
+  EXPECT_EQ(f.modifier(), 0u);
+  EXPECT_EQ(pixel_format_from_libcamera(f), PixelFormat::RGB24);
+  // DRM_FORMAT_RGB888 ('RG24') is B, G, R in memory: arpipe has no such format.
+  EXPECT_EQ(libcamera::formats::RGB888.fourcc(), fourcc('R', 'G', '2', '4'));
+  EXPECT_FALSE(pixel_format_from_libcamera(libcamera::formats::RGB888));
+}
+
+TEST(LibcameraPixelFormat, YuvAndGreyRoundTrip) {
+  // YUYV and NV12 share their fourccs with V4L2; GREY is DRM's R8 ('R8  ').
+  EXPECT_EQ(libcamera_pixel_format(PixelFormat::YUYV).fourcc(), pixel_format_fourcc(PixelFormat::YUYV));
+  EXPECT_EQ(libcamera_pixel_format(PixelFormat::NV12).fourcc(), pixel_format_fourcc(PixelFormat::NV12));
+  EXPECT_EQ(libcamera_pixel_format(PixelFormat::GREY).fourcc(), fourcc('R', '8', ' ', ' '));
+  for (auto f : {PixelFormat::GREY, PixelFormat::RGB24, PixelFormat::YUYV, PixelFormat::NV12})
+    EXPECT_EQ(pixel_format_from_libcamera(libcamera_pixel_format(f)), f) << pixel_format_name(f);
+}
+
+TEST(LibcameraPixelFormat, UnknownFormatsAreNotGuessed) {
+  EXPECT_FALSE(pixel_format_from_libcamera(libcamera::formats::YUV420));
+  EXPECT_FALSE(pixel_format_from_libcamera(libcamera::formats::SBGGR10));
+  EXPECT_FALSE(pixel_format_from_libcamera(libcamera::formats::XRGB8888));
+  EXPECT_FALSE(pixel_format_from_libcamera(libcamera::PixelFormat()));
+}
+
+TEST(LibcameraPixelFormat, AutoPrefersRgb24ThenYuyvThenNv12ThenGrey) {
+  namespace f = libcamera::formats;
+  EXPECT_EQ(preferred_libcamera_format({f::YUV420, f::NV12, f::BGR888}), PixelFormat::RGB24);
+  EXPECT_EQ(preferred_libcamera_format({f::NV12, f::YUYV}), PixelFormat::YUYV);
+  EXPECT_EQ(preferred_libcamera_format({f::YUV420, f::R8, f::NV12}), PixelFormat::NV12);
+  EXPECT_EQ(preferred_libcamera_format({f::R8}), PixelFormat::GREY);
+  EXPECT_FALSE(preferred_libcamera_format({f::YUV420, f::RGB888}));
+}
+
+}  // namespace
+}  // namespace arpipe

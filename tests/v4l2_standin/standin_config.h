@@ -1,0 +1,48 @@
+// The stand-in's TOML configuration: which device paths are served from which recordings, how
+// (formats, pacing, timestamps) and with which faults. Keys and defaults: docs/V4L2_STANDIN.md.
+#pragma once
+
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "fault_plan.h"
+
+namespace arpipe::standin {
+
+// A bad configuration; what() starts with "file:line:column: ".
+class StandinConfigError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+enum class Pacing { Realtime, Fast };
+enum class TimestampBase { Recorded, Live };
+enum class TimestampSource { StartOfExposure, EndOfFrame };
+
+struct DeviceConfig {
+  std::string path;                   // absolute and lexically normal
+  std::filesystem::path recording;    // absolute
+  std::string card = "arpipe V4L2 stand-in";
+  std::string bus_info;               // default "platform:arpipe-standin-<index>"
+  std::vector<std::string> formats = {"native", "MJPG"};
+  Pacing pacing = Pacing::Realtime;
+  TimestampBase timestamps = TimestampBase::Recorded;
+  TimestampSource timestamp_source = TimestampSource::StartOfExposure;
+  bool loop = false;
+  int jpeg_quality = 90;
+  int gain_unity = 100;
+  std::vector<Fault> faults;
+  std::string place;          // "file:line:column" of the [[device]] table
+  std::string formats_place;  // ... of its formats key (the table's when absent)
+};
+
+// Reads and checks the file (every key, type and range; unknown keys are errors). Recordings are
+// not opened here. Throws StandinConfigError.
+std::vector<DeviceConfig> load_standin_config(const std::filesystem::path& file);
+
+// The absolute, lexically normal form of a device path as the process would open it.
+std::string normal_device_path(const std::string& path);
+
+}  // namespace arpipe::standin

@@ -1,0 +1,61 @@
+// The process-wide state of the stand-in: the served devices, the tracked file descriptors (a
+// lock-free table for the interposer's fast path) and the one lock and wake-up the devices share.
+#pragma once
+
+#include <poll.h>
+#include <sys/types.h>
+
+#include <atomic>
+#include <condition_variable>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "device_model.h"
+
+namespace arpipe::standin {
+
+inline constexpr int kMaxTrackedFd = 1 << 16;
+
+// True when fd is one of ours; safe and cheap from any thread, before any constructor has run.
+bool is_tracked(int fd);
+// True while some configuration is loaded (so open() has paths to look at).
+bool is_serving();
+
+class Registry {
+ public:
+  static Registry& get();  // never destroyed: libc calls may arrive during exit
+
+  int load(const char* config_path, std::string& error);
+  void unload();
+  int stats(const char* device_path, struct ::arpipe_v4l2_standin_stats& out);
+
+  // The served device path that `path` names (directly or by a chain of symlinks), or "".
+  std::string served_path(const std::string& normal_path);
+  // Opens a served path: a tracked fd, or -1 with errno (ENOENT while unplugged).
+  int open(const std::string& served, int flags);
+  // Untracks fd if it is ours (before the real close).
+  void close(int fd);
+  // -1 with errno set, or the ioctl's result; `handled` false when fd is not ours after all.
+  int ioctl(int fd, unsigned long request, void* arg, bool& handled);
+  void* mmap(int fd, void* addr, size_t length, int prot, int flags, int64_t offset, bool& handled);
+  using RealPoll = int (*)(pollfd*, nfds_t, int);
+  int poll(pollfd* fds, nfds_t nfds, int timeout_ms, RealPoll real_poll);
+
+ private:
+  Registry() = default;
+  std::shared_ptr<Device> find_device(const std::string& path) const;
+
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::vector<std::shared_ptr<Device>> devices_;
+  std::unordered_map<int, std::shared_ptr<OpenFile>> files_;
+  // The served paths, read by open() without the device lock (a recording's own files are
+  // opened while it is held).
+  std::mutex paths_mutex_;
+  std::vector<std::string> paths_;
+};
+
+}  // namespace arpipe::standin
