@@ -6,6 +6,8 @@
 // (DQBUF + QBUF: a syscall pair on hardware; through the stand-in, a function call plus whatever
 // frame it prepares then) and the copy or decode into the Frame with its metadata; the hand-off
 // into the pipeline's queue; and a memcpy of the same bytes, timed in the same run.
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -19,6 +21,7 @@
 
 #include "capture/live/live_source.h"
 #include "capture/recording/recording_reader.h"
+#include "core/frame_memory.h"
 #include "core/log.h"
 #include "core/pipeline/bounded_queue.h"
 #include "core/pipeline/monotonic_clock.h"
@@ -48,17 +51,17 @@ SourceConfig source_config(const std::string& format) {
   return c;
 }
 
-// A memcpy of `bytes` into a buffer of its own, as a plain copy of the frame would be: ns per copy.
+// A memcpy of a frame of `bytes` into a buffer of its own: ns per copy. The source rotates over
+// four frames as the driver's four buffers do, so the copy, like the capture path's, does not
+// find its frame already in the cache.
 double memcpy_ns(size_t bytes, int repeats) {
-  std::vector<uint8_t> from(bytes, 1), to(bytes);
-  for (int i = 0; i < 3; ++i) std::memcpy(to.data(), from.data(), bytes);  // warm the pages
+  std::vector<std::vector<uint8_t>> from(4, std::vector<uint8_t>(bytes, 1));
+  std::vector<uint8_t> to(bytes);
+  for (auto& f : from) std::memcpy(to.data(), f.data(), bytes);  // fault every page in first
   const int64_t start = monotonic_now_ns();
-  for (int i = 0; i < repeats; ++i) {
-    from[size_t(i) % bytes] = uint8_t(i);
-    std::memcpy(to.data(), from.data(), bytes);
-  }
+  for (int i = 0; i < repeats; ++i) std::memcpy(to.data(), from[size_t(i) % 4].data(), bytes);
   const int64_t end = monotonic_now_ns();
-  if (to[0] == 42) std::puts("");  // keep the copies
+  if (to[size_t(repeats) % bytes] == 42) std::puts("");  // keep the copies
   return double(end - start) / repeats;
 }
 
@@ -66,7 +69,14 @@ struct Row {
   std::string format;
   size_t camera_bytes = 0, frame_bytes = 0;
   double dequeue_us = 0, convert_us = 0, handoff_us = 0, memcpy_us = 0;
+  double page_faults = 0;  // minor page faults per frame, the whole process (stand-in included)
 };
+
+long minor_faults() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_minflt;
+}
 
 Row measure(const fs::path& dir, const fs::path& recording, const std::string& camera_format, int frames) {
   load_standin(dir, recording, fmt::format("pacing = \"fast\"\nformats = [\"{}\"]\nloop = true", camera_format));
@@ -80,6 +90,7 @@ Row measure(const fs::path& dir, const fs::path& recording, const std::string& c
     }
   }
   const StreamCounters before = source->counters().stream;
+  const long faults_before = minor_faults();
   int64_t handoff = 0;
   for (int i = 0; i < frames; ++i) {
     Frame frame;
@@ -93,6 +104,7 @@ Row measure(const fs::path& dir, const fs::path& recording, const std::string& c
     queue.pop();
   }
   const StreamCounters after = source->counters().stream;
+  row.page_faults = double(minor_faults() - faults_before) / frames;
   row.dequeue_us = double(after.dequeue_ns - before.dequeue_ns) / frames * 1e-3;
   row.convert_us = double(after.convert_ns - before.convert_ns) / frames * 1e-3;
   row.handoff_us = double(handoff) / frames * 1e-3;
@@ -122,6 +134,7 @@ std::vector<double> latencies_ms(const fs::path& dir, const fs::path& recording,
 
 int main(int argc, char** argv) {
   log::set_program_name("capture_path");
+  keep_frame_memory_resident();  // as arpiped does
   log::set_max_level(log::Level::Warning);
   fs::path recording = fs::path(ARPIPE_BINARY_DIR) / "default-capture";
   int frames = 300;
@@ -137,11 +150,12 @@ int main(int argc, char** argv) {
     fmt::print("capture path through the V4L2 stand-in: {} ({}x{} {}), {} frames per format\n\n", recording.string(),
                reader.info().width, reader.info().height, pixel_format_name(reader.info().pixel_format), frames);
     fmt::print("| camera sends | frame bytes | DQBUF+QBUF µs | copy/decode µs | hand-off µs | memcpy µs | "
-               "(copy/decode + hand-off) / memcpy |\n|---|---:|---:|---:|---:|---:|---:|\n");
+               "(copy/decode + hand-off) / memcpy | page faults/frame |\n|---|---:|---:|---:|---:|---:|---:|---:|\n");
     for (const char* format : {"YUYV", "GREY", "RGB24", "NV12", "MJPG"}) {
       const Row r = measure(dir, recording, format, frames);
-      fmt::print("| {} | {} | {:.1f} | {:.1f} | {:.2f} | {:.1f} | {:.2f} |\n", r.format, r.frame_bytes, r.dequeue_us,
-                 r.convert_us, r.handoff_us, r.memcpy_us, (r.convert_us + r.handoff_us) / r.memcpy_us);
+      fmt::print("| {} | {} | {:.1f} | {:.1f} | {:.2f} | {:.1f} | {:.2f} | {:.0f} |\n", r.format, r.frame_bytes,
+                 r.dequeue_us, r.convert_us, r.handoff_us, r.memcpy_us, (r.convert_us + r.handoff_us) / r.memcpy_us,
+                 r.page_faults);
     }
     const auto ms = latencies_ms(dir, recording, std::min(frames, 90));
     const auto at = [&](double q) { return ms[std::min(ms.size() - 1, size_t(q * double(ms.size())))]; };

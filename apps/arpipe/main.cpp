@@ -4,6 +4,7 @@
 
 #include "apps/arpipe/commands.h"
 #include "core/log.h"
+#include "core/frame_memory.h"
 
 namespace {
 
@@ -43,6 +44,7 @@ commands:
 }  // namespace
 
 int main(int argc, char** argv) {
+  arpipe::keep_frame_memory_resident();
   arpipe::log::set_program_name("arpipe");
   if (argc < 2 || std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h") {
     std::fputs(kUsage, argc < 2 ? stderr : stdout);

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "apps/arpiped/daemon.h"
+#include "core/frame_memory.h"
 
 namespace {
 
@@ -21,6 +22,7 @@ Exit status: 0 when the stream ended or the daemon was stopped, 2 on a setup err
 }  // namespace
 
 int main(int argc, char** argv) {
+  arpipe::keep_frame_memory_resident();
   arpipe::DaemonOptions options;
   options.config_path = "/etc/arpipe/arpipe.toml";
   for (int i = 1; i < argc; ++i) {

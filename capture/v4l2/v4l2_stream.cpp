@@ -165,7 +165,7 @@ class V4L2Stream final : public CameraStream {
                                     fourcc_text(f.fmt.pix.pixelformat), f.fmt.pix.width, f.fmt.pix.height,
                                     describe_v4l2_offers(offers)));
     mjpeg_ = is_mjpeg_fourcc(choice.fourcc);
-    format_.camera_format = mjpeg_ ? "MJPG" : fourcc_text(choice.fourcc);
+    format_.camera_format = mjpeg_ ? "MJPG" : std::string(pixel_format_name(*pixel_format_from_fourcc(choice.fourcc)));
     format_.format = mjpeg_ ? PixelFormat::RGB24 : *pixel_format_from_fourcc(choice.fourcc);
     format_.width = int(f.fmt.pix.width);
     format_.height = int(f.fmt.pix.height);
