@@ -9,6 +9,9 @@ namespace arpipe {
 
 using Args = std::vector<std::string>;
 
+// A TOML basic string holding `text`, for a --set style config override ("source.path=" + ...).
+std::string toml_string(const std::string& text);
+
 int run_inspect(const Args& args);   // arpipe inspect DIR
 int run_replay(const Args& args);    // arpipe replay DIR [--config FILE] [--set K=V]...
 int run_simulate(const Args& args);  // arpipe simulate --scene FILE --out DIR [--frames N] [--seed S] ...

@@ -27,15 +27,6 @@ constexpr const char* kUsage =
 std::atomic<bool> g_stop{false};
 void on_signal(int) { g_stop = true; }
 
-std::string toml_string(const std::string& text) {
-  std::string out = "\"";
-  for (char c : text) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += c;
-  }
-  return out + "\"";
-}
-
 // The --camera argument as config overrides.
 bool camera_overrides(const std::string& camera, std::vector<std::string>& overrides) {
   if (camera.starts_with("libcamera:")) {

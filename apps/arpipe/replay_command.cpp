@@ -11,15 +11,6 @@
 namespace arpipe {
 
 namespace {
-// A TOML basic string holding text, for a --set override.
-std::string toml_string(const std::string& text) {
-  std::string out = "\"";
-  for (char c : text) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += c;
-  }
-  return out + "\"";
-}
 constexpr const char* kUsage = "usage: arpipe replay DIR [--config FILE] [--set KEY=VALUE]...\n";
 }  // namespace
 

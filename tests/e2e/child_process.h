@@ -28,6 +28,14 @@ inline std::string read_text(const std::filesystem::path& path) {
   return ss.str();
 }
 
+// Lines in a text file (0 when it does not exist): results.jsonl has one per output frame.
+inline size_t count_lines(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  size_t n = 0;
+  for (std::string line; std::getline(in, line);) ++n;
+  return n;
+}
+
 class ChildProcess {
  public:
   // env: extra "NAME=value" entries for the child's environment.

@@ -47,12 +47,7 @@ class DaemonInput : public ::testing::Test {
     args.insert(args.end(), extra.begin(), extra.end());
     return test::run_to_exit(test::build_program("arpiped"), args, dir_ / "logs", &err);
   }
-  size_t result_lines() {
-    std::ifstream in(dir_ / "results.jsonl");
-    size_t n = 0;
-    for (std::string line; std::getline(in, line);) ++n;
-    return n;
-  }
+  size_t result_lines() { return test::count_lines(dir_ / "results.jsonl"); }
   fs::path dir_;
 };
 
