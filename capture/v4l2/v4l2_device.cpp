@@ -110,7 +110,6 @@ std::vector<V4L2FormatOffer> V4L2Device::enumerate_formats() const {
     if (ioctl(VIDIOC_ENUM_FMT, &desc) != 0) break;
     V4L2FormatOffer offer;
     offer.fourcc = desc.pixelformat;
-    offer.description = reinterpret_cast<const char*>(desc.description);
     offer.compressed = desc.flags & V4L2_FMT_FLAG_COMPRESSED;
     for (uint32_t size_index = 0;; ++size_index) {
       v4l2_frmsizeenum size{};

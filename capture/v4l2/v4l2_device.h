@@ -24,7 +24,6 @@ struct V4L2FrameSize {
 
 struct V4L2FormatOffer {
   uint32_t fourcc = 0;
-  std::string description;  // the driver's, e.g. "Motion-JPEG"
   bool compressed = false;
   std::vector<V4L2FrameSize> sizes;  // discrete sizes, or the two ends of a stepwise range
   std::string note;                  // "stepwise 160x120 to 1920x1080 step 8x8", in words

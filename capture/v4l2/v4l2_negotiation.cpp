@@ -14,6 +14,8 @@ namespace arpipe {
 
 bool is_mjpeg_fourcc(uint32_t fourcc) { return fourcc == V4L2_PIX_FMT_MJPEG || fourcc == V4L2_PIX_FMT_JPEG; }
 
+bool same_rate(double fps, double wanted_fps) { return std::abs(fps - wanted_fps) <= 0.005 * wanted_fps; }
+
 bool is_usable_fourcc(uint32_t fourcc) { return is_mjpeg_fourcc(fourcc) || pixel_format_from_fourcc(fourcc).has_value(); }
 
 namespace {
@@ -51,7 +53,7 @@ std::optional<V4L2Fraction> matching_interval(const V4L2FrameSize& size, double 
   }
   if (fps <= 0) return size.intervals.front();
   for (const auto& interval : size.intervals)
-    if (std::abs(interval.fps() - fps) <= 0.005 * fps) return interval;
+    if (same_rate(interval.fps(), fps)) return interval;
   ok = false;
   return std::nullopt;
 }

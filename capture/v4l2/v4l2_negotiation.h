@@ -24,13 +24,16 @@ struct V4L2FormatChoice {
   std::optional<V4L2Fraction> interval;  // nullopt: the camera lists none; leave its rate alone
 };
 
+// The rate a camera gives back counts as the one asked for within 0.5 % (30 fps is 1/30 or
+// 333333/10000000 depending on the driver).
+bool same_rate(double fps, double wanted_fps);
+
 // FourCCs arpipe can take: its own pixel formats, and MJPEG (decoded to RGB24).
 bool is_usable_fourcc(uint32_t fourcc);
 bool is_mjpeg_fourcc(uint32_t fourcc);  // 'MJPG' or 'JPEG'
 
 // The first offer that satisfies the request. "auto" prefers a format passed on as it is over
-// MJPEG (decoding costs), in the camera's order. A requested rate matches a listed interval within
-// 0.5 % (30 fps is 1/30 or 333333/10000000 depending on the driver). Throws CameraError(Refused)
+// MJPEG (decoding costs), in the camera's order; rates match by same_rate(). Throws CameraError(Refused)
 // naming `device` and listing every usable offer when nothing fits.
 V4L2FormatChoice choose_v4l2_format(const std::vector<V4L2FormatOffer>& offers, const V4L2FormatRequest& request,
                                     const std::string& device);

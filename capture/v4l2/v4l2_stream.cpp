@@ -6,9 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cerrno>
-#include <cmath>
 #include <cstring>
 #include <mutex>
 #include <optional>
@@ -188,7 +186,7 @@ class V4L2Stream final : public CameraStream {
     parm.parm.capture.timeperframe = {interval.numerator, interval.denominator};
     if (const int err = device_.ioctl(VIDIOC_S_PARM, &parm); err != 0) fail("VIDIOC_S_PARM", err);
     const V4L2Fraction got{parm.parm.capture.timeperframe.numerator, parm.parm.capture.timeperframe.denominator};
-    if (std::abs(got.fps() - interval.fps()) > 0.005 * interval.fps())
+    if (!same_rate(got.fps(), interval.fps()))
       throw CameraError(CameraError::Kind::Refused,
                         fmt::format("{}: asked for {:.4g} fps, the driver set {:.4g} fps; the camera offers:\n{}",
                                     settings_.device, interval.fps(), got.fps(), describe_v4l2_offers(offers)));

@@ -10,12 +10,12 @@ namespace arpipe {
 namespace {
 
 std::vector<V4L2FormatOffer> webcam() {
-  V4L2FormatOffer yuyv{V4L2_PIX_FMT_YUYV, "YUYV 4:2:2", false, {}, {}};
+  V4L2FormatOffer yuyv{V4L2_PIX_FMT_YUYV, false, {}, {}};
   yuyv.sizes = {{640, 480, {{1, 30}, {1, 15}}, {}}, {320, 240, {{1, 30}}, {}}, {1920, 1080, {{1, 5}}, {}}};
-  V4L2FormatOffer mjpg{V4L2_PIX_FMT_MJPEG, "Motion-JPEG", true, {}, {}};
+  V4L2FormatOffer mjpg{V4L2_PIX_FMT_MJPEG, true, {}, {}};
   // Some drivers give 30 fps as 333333/10000000 (100 ns units).
   mjpg.sizes = {{1920, 1080, {{333333, 10000000}}, {}}, {640, 480, {{1, 30}}, {}}};
-  V4L2FormatOffer h264{v4l2_fourcc('H', '2', '6', '4'), "H.264", true, {}, {}};
+  V4L2FormatOffer h264{v4l2_fourcc('H', '2', '6', '4'), true, {}, {}};
   h264.sizes = {{1920, 1080, {{1, 30}}, {}}};
   return {h264, yuyv, mjpg};
 }
@@ -56,7 +56,7 @@ TEST(V4L2Negotiation, RefusalListsEveryOfferAndNamesTheDevice) {
 }
 
 TEST(V4L2Negotiation, StepwiseSizesAcceptAnySizeInRange) {
-  V4L2FormatOffer grey{V4L2_PIX_FMT_GREY, "Greyscale", false, {}, "stepwise 64x64 to 1280x960 step 16x16"};
+  V4L2FormatOffer grey{V4L2_PIX_FMT_GREY, false, {}, "stepwise 64x64 to 1280x960 step 16x16"};
   grey.sizes = {{1280, 960, {}, {}}, {64, 64, {}, {}}};
   const auto choice = choose_v4l2_format({grey}, {800, 600, 20, "GREY"}, "/dev/video0");
   EXPECT_EQ(choice.width, 800u);
