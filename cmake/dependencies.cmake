@@ -14,6 +14,8 @@ pkg_check_modules(GLES REQUIRED IMPORTED_TARGET glesv2)
 pkg_check_modules(GEOGRAPHICLIB REQUIRED IMPORTED_TARGET geographiclib)  # sun direction in local East-North-Up
 pkg_check_modules(LIBCAMERA REQUIRED IMPORTED_TARGET libcamera)  # live cameras behind an ISP (Raspberry Pi)
 pkg_check_modules(TURBOJPEG REQUIRED IMPORTED_TARGET libturbojpeg)  # MJPEG from UVC webcams
+pkg_check_modules(OPENEXR REQUIRED IMPORTED_TARGET OpenEXR)  # HDR light probes (.exr)
+pkg_check_modules(XXHASH REQUIRED IMPORTED_TARGET libxxhash)  # the PRT cache key: a hash of the mesh content
 
 # mrcal ships no pkg-config or CMake file; -lmrcal pulls in libdogleg and CHOLMOD.
 find_library(MRCAL_LIBRARY mrcal REQUIRED)

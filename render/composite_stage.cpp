@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cstring>
 
+#include "core/image/camera_response.h"
 #include "core/image/pixel_convert.h"
 #include "core/log.h"
 #include "core/pipeline/monotonic_clock.h"
@@ -22,22 +23,29 @@ namespace {
 constexpr std::string_view kFragmentShader = R"glsl(#version 300 es
 precision highp float;
 uniform highp sampler2D u_virtual_layer;  // linear, premultiplied alpha
-uniform highp sampler2D u_camera;         // the camera's sRGB bytes
+uniform highp sampler2D u_camera;         // the camera's bytes, through its response
+uniform int u_response;                   // light.response: 0 sRGB, 1 linear, 2 gamma
+uniform float u_gamma;                    // 2: encoded = linear^(1/g)
 out vec4 out_color;
 
-vec3 decode_srgb(vec3 c) {
+vec3 decode_response(vec3 c) {
+  if (u_response == 1) return c;
+  if (u_response == 2) return pow(c, vec3(u_gamma));
   return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), step(vec3(0.04045), c));
 }
-vec3 encode_srgb(vec3 l) {
+
+vec3 encode_response(vec3 l) {
   l = clamp(l, 0.0, 1.0);
+  if (u_response == 1) return l;
+  if (u_response == 2) return pow(l, vec3(1.0 / u_gamma));
   return mix(l * 12.92, 1.055 * pow(l, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), l));
 }
 
 void main() {
   ivec2 pixel = ivec2(gl_FragCoord.xy);
   vec4 virtual_layer = texelFetch(u_virtual_layer, pixel, 0);
-  vec3 camera = decode_srgb(texelFetch(u_camera, pixel, 0).rgb);
-  out_color = vec4(encode_srgb(virtual_layer.rgb + (1.0 - virtual_layer.a) * camera), 1.0);
+  vec3 camera = decode_response(texelFetch(u_camera, pixel, 0).rgb);
+  out_color = vec4(encode_response(virtual_layer.rgb + (1.0 - virtual_layer.a) * camera), 1.0);
 }
 )glsl";
 
@@ -72,6 +80,19 @@ void CompositeStage::configure(const Config& config) {
     glUniform1i(program_.uniform("u_virtual_layer"), 0);
     glUniform1i(program_.uniform("u_camera"), 1);
   }
+  // The virtual layer is linear light: it goes out through the same response the camera's pixels
+  // came in by, so virtual and real brighten and darken together.
+  CameraResponse response;
+  try {
+    response = CameraResponse::parse(config.light.response, "light.response");
+  } catch (const std::exception& e) {
+    throw ConfigError(fmt::format("{}: {}", config.file.string(), e.what()));
+  }
+  glUseProgram(program_.id());
+  glUniform1i(program_.uniform("u_response"), response.kind() == CameraResponse::Kind::Linear  ? 1
+                                               : response.kind() == CameraResponse::Kind::Gamma ? 2
+                                                                                                 : 0);
+  glUniform1f(program_.uniform("u_gamma"), static_cast<float>(response.gamma_value()));
   lens_ = lens;
   last_error_.clear();
 }

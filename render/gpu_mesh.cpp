@@ -3,6 +3,7 @@
 #include "render/gpu_mesh.h"
 
 #include <cstdint>
+#include <stdexcept>
 
 #include "render/gl_error.h"
 
@@ -17,12 +18,16 @@ void upload(GLenum target, const GlBuffer& buffer, const std::vector<T>& data) {
 
 }  // namespace
 
-GpuMesh::GpuMesh(const Mesh& mesh)
+GpuMesh::GpuMesh(const Mesh& mesh, std::span<const float> transfer)
     : vertex_array_(GlVertexArray::create()),
       positions_(GlBuffer::create()),
       normals_(GlBuffer::create()),
       indices_(GlBuffer::create()),
-      parts_(mesh.parts) {
+      transfer_(GlBuffer::create()),
+      parts_(mesh.parts),
+      has_transfer_(!transfer.empty()) {
+  if (has_transfer_ && transfer.size() != 9 * mesh.vertex_count())
+    throw std::invalid_argument("GpuMesh: the transfer needs 9 coefficients per vertex");
   glBindVertexArray(vertex_array_.get());
   upload(GL_ARRAY_BUFFER, positions_, mesh.positions);
   glEnableVertexAttribArray(kPositionAttribute);
@@ -30,6 +35,17 @@ GpuMesh::GpuMesh(const Mesh& mesh)
   upload(GL_ARRAY_BUFFER, normals_, mesh.normals);
   glEnableVertexAttribArray(kNormalAttribute);
   glVertexAttribPointer(kNormalAttribute, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
+  if (has_transfer_) {
+    glBindBuffer(GL_ARRAY_BUFFER, transfer_.get());
+    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(transfer.size_bytes()), transfer.data(), GL_STATIC_DRAW);
+    constexpr GLsizei stride = 9 * sizeof(float);
+    const GLint sizes[3] = {4, 4, 1};
+    for (GLuint k = 0; k < 3; ++k) {
+      glEnableVertexAttribArray(kTransferAttribute + k);
+      glVertexAttribPointer(kTransferAttribute + k, sizes[k], GL_FLOAT, GL_FALSE, stride,
+                            reinterpret_cast<const void*>(uintptr_t{4 * k} * sizeof(float)));
+    }
+  }
   upload(GL_ELEMENT_ARRAY_BUFFER, indices_, mesh.indices);  // recorded in the vertex array
   glBindVertexArray(0);
   glBindBuffer(GL_ARRAY_BUFFER, 0);

@@ -5,6 +5,7 @@
 
 #include <array>
 
+#include "core/light/sh_rotation.h"
 #include "render/shadow_lookup_glsl.h"
 
 namespace arpipe {
@@ -13,14 +14,27 @@ namespace {
 constexpr std::string_view kShadingVertexShader = R"glsl(
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
+layout(location = 2) in vec4 a_transfer0;  // PRT transfer coefficients 0-3 (object frame)
+layout(location = 3) in vec4 a_transfer1;  // 4-7
+layout(location = 4) in float a_transfer2; // 8
 uniform mat3 u_world_from_object_rotation;  // without the scale
 uniform vec3 u_world_from_object_translation;
 uniform float u_object_scale;
+uniform bool u_prt;
+uniform vec3 u_prt_light[9];  // radiance SH in the object's frame
 out vec3 v_normal_world;
 out vec3 v_world;
+out vec3 v_prt_radiance;      // the environment's outgoing radiance for albedo 1
 
 void main() {
   gl_Position = camera_to_clip(pose_camera_point(a_position));
+  // Seed 002: one dot product of light and transfer per vertex, interpolated (Gouraud).
+  v_prt_radiance = u_prt ? a_transfer0.x * u_prt_light[0] + a_transfer0.y * u_prt_light[1]
+                           + a_transfer0.z * u_prt_light[2] + a_transfer0.w * u_prt_light[3]
+                           + a_transfer1.x * u_prt_light[4] + a_transfer1.y * u_prt_light[5]
+                           + a_transfer1.z * u_prt_light[6] + a_transfer1.w * u_prt_light[7]
+                           + a_transfer2 * u_prt_light[8]
+                         : vec3(0.0);
   // The camera's motion does not move the object in the world, so one normal and one world
   // position serve every row.
   v_normal_world = u_world_from_object_rotation * a_normal;
@@ -32,6 +46,8 @@ constexpr std::string_view kShadingFragmentShaderTemplate = R"glsl(#version 300 
 precision highp float;
 in vec3 v_normal_world;
 in vec3 v_world;
+in vec3 v_prt_radiance;
+uniform bool u_prt;
 uniform vec4 u_base_color;       // linear, straight alpha
 uniform vec3 u_light_direction;  // world frame, unit, towards the light
 uniform vec4 u_light_position;   // w = 1: a lamp there (the direction is per point)
@@ -65,7 +81,8 @@ void main() {{
     out_color = vec4(0.0, 0.0, 0.0, 1.0 - ratio);
     return;
   }}
-  vec3 rgb = u_base_color.rgb * max(ambient_at(normal) + u_light_color * (lambert * visibility), 0.0) * u_exposure_scale;
+  vec3 environment = u_prt ? v_prt_radiance : ambient_at(normal);
+  vec3 rgb = u_base_color.rgb * max(environment + u_light_color * (lambert * visibility), 0.0) * u_exposure_scale;
   out_color = vec4(rgb * u_base_color.a, u_base_color.a);
 }}
 )glsl";
@@ -105,6 +122,17 @@ std::array<float, 9> column_major(const Mat3& m) {
   std::array<float, 9> out{};
   for (size_t col = 0; col < 3; ++col)
     for (size_t row = 0; row < 3; ++row) out[col * 3 + row] = static_cast<float>(m[row][col]);
+  return out;
+}
+
+// Radiance SH (world) as seen in the object's frame: the function turned by R_object_world.
+std::array<float, 27> object_frame_light(const std::array<Vec3, 9>& radiance_sh_world, const Mat3& R_world_object) {
+  ShRgb world(3);
+  std::copy(radiance_sh_world.begin(), radiance_sh_world.end(), world.c.begin());
+  const ShRgb object = ShRotation(transpose(R_world_object), 3).apply(world);
+  std::array<float, 27> out{};
+  for (size_t i = 0; i < 9; ++i)
+    for (size_t c = 0; c < 3; ++c) out[i * 3 + c] = static_cast<float>(object.c[i][c]);
   return out;
 }
 
@@ -178,6 +206,8 @@ void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, c
   const GLint object_scale = program.uniform("u_object_scale");
   const GLint base_color = program.uniform("u_base_color");
   const GLint shadow_catcher = program.uniform("u_shadow_catcher");
+  const GLint prt = program.uniform("u_prt");
+  const GLint prt_light = program.uniform("u_prt_light");
   for (const ObjectAtInstant& item : objects) {
     set_row_poses(program, "pose", item.poses, item.object->scale);
     const std::array<float, 9> rotation = column_major(item.object->T_world_object.rotation());
@@ -185,6 +215,13 @@ void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, c
     set_vec3(world_from_object_translation, item.object->T_world_object.translation());
     glUniform1f(object_scale, static_cast<float>(item.object->scale));
     glUniform1i(shadow_catcher, item.object->shadow_catcher ? 1 : 0);
+    const bool use_prt = item.object->mesh->has_transfer() && !item.object->shadow_catcher;
+    glUniform1i(prt, use_prt ? 1 : 0);
+    if (use_prt) {
+      // The transfer lives in the object's frame: turn the world's light into it.
+      const std::array<float, 27> light = object_frame_light(lighting.radiance_sh, item.object->T_world_object.rotation());
+      glUniform3fv(prt_light, 9, light.data());
+    }
     item.object->mesh->draw([&](const MeshPart& part) {
       const std::array<float, 4>& color = item.object->base_color ? *item.object->base_color : part.base_color;
       glUniform4f(base_color, color[0], color[1], color[2], color[3]);

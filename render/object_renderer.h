@@ -19,6 +19,8 @@ namespace arpipe {
 // * exposure_scale, with ambient(n) = ambient + sum_i ambient_sh[i] * Y_i(n) (real SH, Green's
 // order): for an estimate in scene-linear units, color = E / pi and ambient_sh the ambient
 // irradiance's SH over pi, and exposure_scale turns scene-linear into the frame's linear pixels.
+// A mesh with baked transfer (PRT) replaces ambient(n) by sum_i L_i T_i(vertex), with L the
+// radiance_sh turned into the object's frame: the same light, self-shadowed.
 struct Lighting {
   Vec3 direction{0, 0, 1};  // world frame, unit, towards the light
   bool local = false;       // a lamp at `position`: the direction is then taken per point
@@ -26,6 +28,7 @@ struct Lighting {
   Vec3 color{1, 1, 1};
   Vec3 ambient{0, 0, 0};
   std::array<Vec3, 9> ambient_sh{};
+  std::array<Vec3, 9> radiance_sh{};  // the ambient light as radiance SH (world), for PRT
   double exposure_scale = 1;
   const ShadowLookup* shadow = nullptr;  // nullptr: nothing is shadowed
 };

@@ -4,11 +4,14 @@
 
 #include <fmt/format.h>
 
+#include <chrono>
 #include <cmath>
 #include <map>
 
+#include "core/log.h"
 #include "core/scene/builtin_meshes.h"
 #include "core/scene/gltf_loader.h"
+#include "render/prt/prt_cache.h"
 
 namespace arpipe {
 namespace {
@@ -34,6 +37,34 @@ Bounds scaled(const Bounds& box, double scale) {
   return out;
 }
 
+// The first 3 bands of the object's baked transfer (from the cache, else baked now and cached),
+// or nothing for prt = "off".
+std::vector<float> transfer_for(const Config& config, const std::string& mesh_source, const Mesh& mesh,
+                                const std::string& prt) {
+  const std::optional<TransferKind> kind = parse_transfer_kind(prt);
+  if (!kind || mesh.vertex_count() == 0) return {};
+  PrtBakeSettings settings;
+  settings.kind = *kind;
+  settings.bands = config.render.prt.bands;
+  settings.samples_per_axis = config.render.prt.samples;
+  const std::filesystem::path cache_dir =
+      config.render.prt.cache_dir.empty() ? default_prt_cache_dir() : config.render.prt.cache_dir;
+  const auto start = std::chrono::steady_clock::now();
+  const PrtLoad load = load_or_bake_prt(mesh, settings, cache_dir);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (load.baked)
+    log::info("prt: baked {} transfer of {} ({} vertices, {} directions) in {:.2f} s{}", prt, mesh_source,
+              mesh.vertex_count(), settings.samples_per_axis * settings.samples_per_axis, seconds,
+              load.file.empty() ? std::string() : fmt::format(" into {}", load.file.string()));
+  if (!load.note.empty()) log::warn("prt: {}: {}", mesh_source, load.note);
+  const size_t count = size_t(load.transfer.bands * load.transfer.bands);
+  std::vector<float> first9;
+  first9.reserve(9 * mesh.vertex_count());
+  for (size_t v = 0; v < load.transfer.vertex_count(); ++v)
+    for (size_t i = 0; i < 9; ++i) first9.push_back(i < count ? load.transfer.at(v)[i] : 0.0f);
+  return first9;
+}
+
 }  // namespace
 
 std::vector<RenderObject> load_render_objects(const Config& config) {
@@ -45,10 +76,12 @@ std::vector<RenderObject> load_render_objects(const Config& config) {
   std::vector<RenderObject> objects;
   for (size_t i = 0; i < config.render.objects.size(); ++i) {
     const SceneObject& object = config.render.objects[i];
-    auto found = loaded.find(object.mesh);
+    const std::string key = object.mesh + "\n" + object.prt;
+    auto found = loaded.find(key);
     if (found == loaded.end()) {
       const Mesh mesh = load_mesh(config, i, object.mesh);
-      found = loaded.emplace(object.mesh, Loaded{std::make_shared<const GpuMesh>(mesh), mesh.bounds()}).first;
+      const std::vector<float> transfer = transfer_for(config, object.mesh, mesh, object.prt);
+      found = loaded.emplace(key, Loaded{std::make_shared<const GpuMesh>(mesh, transfer), mesh.bounds()}).first;
     }
     RenderObject out;
     out.mesh_source = object.mesh;

@@ -244,6 +244,8 @@ Lighting RenderStage::frame_lighting(const FrameContext& ctx, double& angular_di
     lighting.direction = settings_.light_direction;
     lighting.color = settings_.light_color;
     lighting.ambient = settings_.ambient;
+    // The same ambient as radiance: a constant L has L_00 = L sqrt(4 pi) and irradiance / pi = L.
+    lighting.radiance_sh[0] = std::sqrt(4 * std::numbers::pi) * settings_.ambient;
     lighting.local = settings_.light_distance_m > 0;
     lighting.position = settings_.light_distance_m * settings_.light_direction;
     angular_diameter_rad = settings_.shadows.light_angular_diameter_deg * kRadiansPerDegree;
@@ -269,6 +271,7 @@ Lighting RenderStage::frame_lighting(const FrameContext& ctx, double& angular_di
     const size_t band = i == 0 ? 0 : (i < 4 ? 1 : 2);
     lighting.ambient_sh[i] = kIrradianceOverPi[band] * radiance_sh[i];
   }
+  lighting.radiance_sh = radiance_sh;
   const double exposure_s = 1e-9 * double(ctx.camera.meta.exposure_ns);
   lighting.exposure_scale = exposure_s > 0 ? exposure_s * ctx.camera.meta.total_gain() : 1.0;
   return lighting;

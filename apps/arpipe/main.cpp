@@ -27,6 +27,14 @@ commands:
                                      vs the converged reference and the simulator's truth
   bench shadows [--frames N]         shadow methods and map sizes: time against the error of
                                      the shadow on the ground vs the simulator's ray tracing
+  bench sh [--samples N] [--seed S]  spherical harmonics: reconstruction error against bands,
+                                     irradiance error of 9 coefficients vs Monte Carlo
+  bench prt [OPTIONS]                PRT bake: time against samples against the error vs a
+                                     ray-traced reference; run-time cost vs Lambert shading
+  sh --probe FILE --layout L [--bands N] [--normal X,Y,Z]... [--reconstruct OUT]
+                                     an HDR light probe's SH coefficients and irradiance
+  bake MODEL [--kind K] [--bands N] [--samples N] [--cache-dir DIR] [--force]
+                                     precompute a mesh's radiance transfer (PRT) into the cache
   sun --lat DEG --lon DEG --time ISO8601 [--alt M] [--delta-t S] [--pressure MBAR] [--temperature C]
       [--heading DEG] [--declination DEG] [--algorithm spa|psa|both]
                                      the sun's azimuth, elevation and direction (ENU, anchor
@@ -62,6 +70,8 @@ int main(int argc, char** argv) {
   if (command == "sun") return arpipe::run_sun(args);
   if (command == "cameras") return arpipe::run_cameras(args);
   if (command == "record") return arpipe::run_record(args);
+  if (command == "sh") return arpipe::run_sh(args);
+  if (command == "bake") return arpipe::run_bake(args);
   std::fprintf(stderr, "arpipe: unknown command '%s'\n%s", command.c_str(), kUsage);
   return 2;
 }

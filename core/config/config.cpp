@@ -368,8 +368,8 @@ bool is_camera_response(const std::string& text) {
 
 void read_light(const ConfigReader& r, const toml::table& t, LightConfig& out) {
   const std::string p = "light.";
-  r.check_keys(t, p, {"source", "response", "smoothing_s", "ground_albedo", "probe", "sun"}, "[light]");
-  r.read(t, p, "source", out.source, {"fixed", "probe", "sun"});
+  r.check_keys(t, p, {"source", "response", "smoothing_s", "ground_albedo", "probe", "sun", "environment"}, "[light]");
+  r.read(t, p, "source", out.source, {"fixed", "probe", "sun", "environment"});
   r.read(t, p, "response", out.response);
   if (!is_camera_response(out.response))
     r.fail_got(*t.get("response"), p + "response", "\"srgb\", \"linear\" or \"gamma:<g>\" with 0 < g <= 10",
@@ -414,13 +414,25 @@ void read_light(const ConfigReader& r, const toml::table& t, LightConfig& out) {
     r.read(*sun, sp, "direct_fraction", out.sun.direct_fraction, [](double v) { return v >= 0 && v <= 1; },
            "a number in [0, 1]");
   }
+  if (const toml::table* environment = r.table(t, p, "environment")) {
+    const std::string ep = "light.environment.";
+    r.check_keys(*environment, ep, {"file", "layout", "yaw_deg", "scale", "window"}, "[light.environment]");
+    r.read(*environment, ep, "file", out.environment.file);
+    r.read(*environment, ep, "layout", out.environment.layout, {"angular", "mirror-ball", "equirect", "cube-cross"});
+    r.read_degrees(*environment, ep, "yaw_deg", out.environment.yaw_rad);
+    r.read(*environment, ep, "scale", out.environment.scale, [](double v) { return v > 0 && v <= 1e12; },
+           "a number in (0, 1e12]");
+    r.read(*environment, ep, "window", out.environment.window, {"none", "hanning", "lanczos"});
+  }
+  if (out.source == "environment" && out.environment.file.empty())
+    r.fail(*t.get("source"), p + "source", "light.environment.file to be set when the source is \"environment\"");
 }
 
 void read_render(const ConfigReader& r, const toml::table& t, RenderConfig& out) {
   const std::string p = "render.";
   r.check_keys(t, p,
                {"enabled", "objects", "light_direction", "light_distance_m", "light_color", "ambient", "msaa_samples", "egl_platform",
-                "lens", "lens_canvas_scale", "rolling_shutter", "max_predicted_uncertainty_deg", "blur", "shadows"},
+                "lens", "lens_canvas_scale", "rolling_shutter", "max_predicted_uncertainty_deg", "blur", "shadows", "prt"},
                "[render]");
   r.read(t, p, "enabled", out.enabled);
   if (const toml::array* objects = r.array_of_tables(t, p, "objects")) {
@@ -428,7 +440,7 @@ void read_render(const ConfigReader& r, const toml::table& t, RenderConfig& out)
     for (size_t i = 0; i < objects->size(); ++i) {
       const toml::table& object_table = *(*objects)[i].as_table();
       const std::string op = fmt::format("render.objects[{}].", i);
-      r.check_keys(object_table, op, {"mesh", "position_m", "yaw_deg", "scale", "color"}, "[[render.objects]]");
+      r.check_keys(object_table, op, {"mesh", "position_m", "yaw_deg", "scale", "color", "prt"}, "[[render.objects]]");
       SceneObject object;
       r.read(object_table, op, "mesh", object.mesh);
       if (object.mesh.empty()) r.fail(*object_table.get("mesh"), op + "mesh", "\"builtin:cube\", \"builtin:pyramid\" or a glTF file");
@@ -436,6 +448,7 @@ void read_render(const ConfigReader& r, const toml::table& t, RenderConfig& out)
       r.read_degrees(object_table, op, "yaw_deg", object.yaw_rad);
       r.read(object_table, op, "scale", object.scale, positive, "a number > 0");
       r.read(object_table, op, "color", object.color, non_negative, "numbers >= 0");
+      r.read(object_table, op, "prt", object.prt, {"off", "unshadowed", "shadowed", "interreflected"});
       out.objects.push_back(object);
     }
   }
@@ -468,6 +481,13 @@ void read_render(const ConfigReader& r, const toml::table& t, RenderConfig& out)
            "a number in [0, 1000] (pixels)");
   }
   if (const toml::table* shadows = r.table(t, p, "shadows")) read_shadows(r, *shadows, out.shadows);
+  if (const toml::table* prt = r.table(t, p, "prt")) {
+    const std::string pp = "render.prt.";
+    r.check_keys(*prt, pp, {"samples", "bands", "cache_dir"}, "[render.prt]");
+    r.read(*prt, pp, "samples", out.prt.samples, 2, 256);
+    r.read(*prt, pp, "bands", out.prt.bands, 3, 8);
+    r.read(*prt, pp, "cache_dir", out.prt.cache_dir);
+  }
 }
 
 void read_sinks(const ConfigReader& r, const toml::table& t, SinksConfig& out) {
@@ -753,6 +773,12 @@ std::string default_config_toml() {
   entry("pressure_mbar", f(d.light.sun.pressure_mbar), "for refraction");
   entry("temperature_c", f(d.light.sun.temperature_c), "for refraction");
   entry("direct_fraction", f(d.light.sun.direct_fraction), "[0, 1]: the sun's share of the light on the ground");
+  out += "\n[light.environment]            # an HDR light probe file as the whole light\n";
+  entry("file", s(d.light.environment.file.string()), "Radiance .hdr or OpenEXR .exr; required with source = \"environment\"");
+  entry("layout", s(d.light.environment.layout), "\"angular\", \"mirror-ball\", \"equirect\" or \"cube-cross\"");
+  entry("yaw_deg", f(d.light.environment.yaw_rad / kRadiansPerDegree), "turn of the probe about world z (probe up = world z)");
+  entry("scale", f(d.light.environment.scale), "(0, 1e12]: the file's radiance units to scene-linear units");
+  entry("window", s(d.light.environment.window), "\"none\", \"hanning\" or \"lanczos\": SH windowing against ringing");
 
   out += "\n[render]\n";
   entry("enabled", b(d.render.enabled));
@@ -791,6 +817,10 @@ std::string default_config_toml() {
   entry("receiver_height_m", f(d.render.shadows.receiver_height_m), "world z of the real ground");
   entry("light_angular_diameter_deg", f(d.render.shadows.light_angular_diameter_deg),
         "[0, 90): size of the fixed light (pcss); estimates bring their own");
+  out += "\n[render.prt]                   # precomputed radiance transfer, baked once per mesh (arpipe bake)\n";
+  entry("samples", fmt::format("{}", d.render.prt.samples), "2..256 per axis: samples^2 directions per vertex");
+  entry("bands", fmt::format("{}", d.render.prt.bands), "3..8 SH bands baked (the shader uses 3)");
+  entry("cache_dir", s(d.render.prt.cache_dir.string()), "\"\": $XDG_CACHE_HOME/arpipe/prt, else ~/.cache/arpipe/prt");
   out += "\n# Virtual objects: one [[render.objects]] each, placed in the world (anchor) frame.\n";
   for (const SceneObject& object : d.render.objects) {
     out += "[[render.objects]]\n";
@@ -799,6 +829,7 @@ std::string default_config_toml() {
     entry("yaw_deg", f(object.yaw_rad / kRadiansPerDegree), "about world z");
     entry("scale", f(object.scale), "> 0");
     entry("color", vec(object.color), "linear base colour of builtin meshes, >= 0");
+    entry("prt", s(object.prt), "environment light: \"off\", \"unshadowed\", \"shadowed\" or \"interreflected\"");
   }
 
   out += "\n[sinks.png]\n";

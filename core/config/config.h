@@ -100,6 +100,10 @@ struct SceneObject {
   double yaw_rad = 0;                  // about world z
   double scale = 1.0;
   Vec3 color{0.8, 0.3, 0.1};           // linear base colour for builtin meshes
+  // Its environment light: "off" (SH irradiance at each pixel's normal, no self-shadowing), or the
+  // precomputed radiance transfer baked per vertex ([render.prt]): "unshadowed", "shadowed"
+  // (self-shadowing) or "interreflected" (plus one grey bounce).
+  std::string prt = "shadowed";
 
   bool operator==(const SceneObject&) const = default;
 };
@@ -139,6 +143,16 @@ struct ShadowConfig {
   bool operator==(const ShadowConfig&) const = default;
 };
 
+// The precomputed radiance transfer bake (render/prt): run once per mesh and kept in a cache
+// keyed by the mesh's content.
+struct PrtConfig {
+  int samples = 24;                       // per axis of the stratified sphere samples (samples^2 rays)
+  int bands = 3;                          // baked bands, 3..8 (the shader uses the first 3)
+  std::filesystem::path cache_dir;        // empty: $XDG_CACHE_HOME/arpipe/prt or ~/.cache/arpipe/prt
+
+  bool operator==(const PrtConfig&) const = default;
+};
+
 struct RenderConfig {
   bool enabled = true;
   std::vector<SceneObject> objects{SceneObject{}};
@@ -170,6 +184,7 @@ struct RenderConfig {
   double max_predicted_uncertainty_deg = 5.0;
   BlurConfig blur;
   ShadowConfig shadows;
+  PrtConfig prt;
 
   bool operator==(const RenderConfig&) const = default;
 };
@@ -210,10 +225,23 @@ struct SunConfig {
   bool operator==(const SunConfig&) const = default;
 };
 
+// A light probe image file as the whole light (static): an HDR panorama of the place, projected
+// onto spherical harmonics once at configure.
+struct EnvironmentConfig {
+  std::filesystem::path file;            // Radiance .hdr or OpenEXR .exr
+  std::string layout = "equirect";       // "angular", "mirror-ball", "equirect" or "cube-cross"
+  double yaw_rad = 0;                    // turn of the probe about world z (probe up = world +z)
+  double scale = 1;                      // radiance units of the file -> scene-linear units
+  std::string window = "none";           // "none", "hanning" or "lanczos": against ringing
+
+  bool operator==(const EnvironmentConfig&) const = default;
+};
+
 // The light stage: where the light comes from.
 struct LightConfig {
   // "fixed": render.light_direction, light_color and ambient (display-referred, no estimation);
-  // "probe": a light probe sphere in view ([light.probe]); "sun": place and time ([light.sun]).
+  // "probe": a light probe sphere in view ([light.probe]); "sun": place and time ([light.sun]);
+  // "environment": an HDR light probe file ([light.environment]).
   std::string source = "fixed";
   std::string response = "srgb";         // the camera's response curve: "srgb", "linear" or "gamma:<g>"
   double smoothing_s = 0.3;              // time constant of the temporal smoothing, [0, 60]
@@ -222,6 +250,7 @@ struct LightConfig {
   Vec3 ground_albedo{0.3, 0.3, 0.3};
   ProbeConfig probe;
   SunConfig sun;
+  EnvironmentConfig environment;
 
   bool operator==(const LightConfig&) const = default;
 };

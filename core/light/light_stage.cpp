@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <time.h>
 
+#include "core/light/environment_light.h"
 #include "core/log.h"
 #include "core/pipeline/monotonic_clock.h"
 
@@ -29,6 +30,7 @@ void LightStage::configure(const Config& config) {
   }
   std::unique_ptr<ProbeLightEstimator> probe;
   std::unique_ptr<SunLight> sun;
+  LightEstimate environment;
   Source source = Source::Fixed;
   if (light.source == "probe") {
     source = Source::Probe;
@@ -52,10 +54,17 @@ void LightStage::configure(const Config& config) {
     source = Source::Sun;
     sun = std::make_unique<SunLight>();
     sun->configure(light.sun, light.ground_albedo, response, light.smoothing_s, config.file);
+  } else if (light.source == "environment") {
+    source = Source::Environment;
+    environment = load_environment_lighting(config).estimate;
+    log::info("light: environment {} ({}), ambient L00 = ({:.4g}, {:.4g}, {:.4g})", light.environment.file.string(),
+              light.environment.layout, environment.ambient_sh[0][0], environment.ambient_sh[0][1],
+              environment.ambient_sh[0][2]);
   }
   source_ = source;
   probe_ = std::move(probe);
   sun_ = std::move(sun);
+  environment_ = std::move(environment);
   probe_centre_ = light.probe.center_m;
   ground_albedo_ = light.ground_albedo;
   response_ = response;
@@ -67,6 +76,11 @@ void LightStage::process(FrameContext& ctx) noexcept {
   const auto start = std::chrono::steady_clock::now();
   if (source_ == Source::Fixed) {
     ctx.record_timing(std::string(name()), milliseconds_since(start), "fixed light (render.light_*)");
+    return;
+  }
+  if (source_ == Source::Environment) {
+    ctx.light = environment_;
+    ctx.record_timing(std::string(name()), milliseconds_since(start), "environment file (static)");
     return;
   }
   const bool pose_valid = ctx.pose.state == TrackState::Tracking || ctx.pose.state == TrackState::Predicted;

@@ -1,6 +1,7 @@
 // The light stage: where this frame's light comes from (light.source): the config's fixed light,
-// a light probe sphere in view (probe_light_estimator.h), or the sun from place and time
-// (sun_light.h). Its estimate travels in FrameContext::light to the renderer.
+// a light probe sphere in view (probe_light_estimator.h), the sun from place and time
+// (sun_light.h), or an HDR light probe file (environment_light.h). Its estimate travels in
+// FrameContext::light to the renderer.
 #pragma once
 
 #include <memory>
@@ -24,10 +25,11 @@ class LightStage final : public Stage {
   void process(FrameContext& ctx) noexcept override;
 
  private:
-  enum class Source { Fixed, Probe, Sun };
+  enum class Source { Fixed, Probe, Sun, Environment };
   Source source_ = Source::Fixed;
   std::unique_ptr<ProbeLightEstimator> probe_;
   std::unique_ptr<SunLight> sun_;
+  LightEstimate environment_;  // Environment: the same every frame
   Vec3 probe_centre_{0, 0, 0};
   Vec3 ground_albedo_{0.3, 0.3, 0.3};
   CameraResponse response_;

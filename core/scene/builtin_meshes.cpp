@@ -1,4 +1,5 @@
-// The procedural meshes a scene can name without a file ("builtin:cube", "builtin:pyramid", "builtin:sphere"):
+// The procedural meshes a scene can name without a file ("builtin:cube", "builtin:pyramid",
+// "builtin:sphere", "builtin:cup"):
 // base on z = 0, centred on the object origin in x and y, about 6 cm across.
 #include "core/scene/builtin_meshes.h"
 
@@ -107,6 +108,30 @@ Mesh make_sphere_mesh(double radius_m, int rings) {
   return builder.finish();
 }
 
+Mesh make_cup_mesh(double outer_m, double inner_m, double height_m, double depth_m, int subdivisions) {
+  const double h = outer_m / 2, a = inner_m / 2, H = height_m, D = depth_m, rim = h - a, F = H - D;
+  const int n = subdivisions;
+  MeshBuilder builder;
+  // Outside: the four sides and the bottom, as the cube's.
+  builder.add_grid({-h, -h, 0}, {0, outer_m, 0}, {outer_m, 0, 0}, n);  // bottom, -z
+  builder.add_grid({h, -h, 0}, {0, outer_m, 0}, {0, 0, H}, n);         // +x
+  builder.add_grid({-h, -h, 0}, {0, 0, H}, {0, outer_m, 0}, n);        // -x
+  builder.add_grid({-h, h, 0}, {0, 0, H}, {outer_m, 0, 0}, n);         // +y
+  builder.add_grid({-h, -h, 0}, {outer_m, 0, 0}, {0, 0, H}, n);        // -y
+  // The rim around the pit's mouth, facing +z.
+  builder.add_grid({-h, -h, H}, {outer_m, 0, 0}, {0, rim, 0}, n);
+  builder.add_grid({-h, a, H}, {outer_m, 0, 0}, {0, rim, 0}, n);
+  builder.add_grid({-h, -a, H}, {rim, 0, 0}, {0, inner_m, 0}, n);
+  builder.add_grid({a, -a, H}, {rim, 0, 0}, {0, inner_m, 0}, n);
+  // The pit: four walls facing its middle and its floor facing +z.
+  builder.add_grid({-a, -a, F}, {0, inner_m, 0}, {0, 0, D}, n);  // at x = -a, facing +x
+  builder.add_grid({a, -a, F}, {0, 0, D}, {0, inner_m, 0}, n);   // at x = +a, facing -x
+  builder.add_grid({-a, -a, F}, {0, 0, D}, {inner_m, 0, 0}, n);  // at y = -a, facing +y
+  builder.add_grid({-a, a, F}, {inner_m, 0, 0}, {0, 0, D}, n);   // at y = +a, facing -y
+  builder.add_grid({-a, -a, F}, {inner_m, 0, 0}, {0, inner_m, 0}, n);  // floor
+  return builder.finish();
+}
+
 Mesh make_plane_mesh(double edge_m, int subdivisions) {
   MeshBuilder builder;
   builder.add_grid({-edge_m / 2, -edge_m / 2, 0}, {edge_m, 0, 0}, {0, edge_m, 0}, subdivisions);  // facing +z
@@ -119,6 +144,7 @@ std::optional<Mesh> make_builtin_mesh(std::string_view source) {
   if (source == "builtin:cube") return make_cube_mesh();
   if (source == "builtin:pyramid") return make_pyramid_mesh();
   if (source == "builtin:sphere") return make_sphere_mesh();
+  if (source == "builtin:cup") return make_cup_mesh();
   return std::nullopt;
 }
 

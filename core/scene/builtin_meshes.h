@@ -1,5 +1,5 @@
 // The procedural meshes a scene can name without a file ("builtin:cube", "builtin:pyramid",
-// "builtin:sphere"):
+// "builtin:sphere", "builtin:cup"):
 // base on z = 0, centred on the object origin in x and y, about 6 cm across.
 #pragma once
 
@@ -16,12 +16,17 @@ Mesh make_cube_mesh(double edge_m = 0.06, int subdivisions = 8);
 Mesh make_pyramid_mesh(double base_m = 0.06, double height_m = 0.06, int subdivisions = 8);
 // Resting on z = 0: centre at (0, 0, radius).
 Mesh make_sphere_mesh(double radius_m = 0.03, int rings = 24);
+// A concave solid: a box of outer_m x outer_m x height_m with a square pit inner_m across and
+// depth_m deep open at the top, flat faces (the walls shade each other: PRT's test model).
+Mesh make_cup_mesh(double outer_m = 0.06, double inner_m = 0.04, double height_m = 0.06, double depth_m = 0.045,
+                   int subdivisions = 8);
 // A square on z = 0 facing +z (the shadow catcher's ground patch).
 Mesh make_plane_mesh(double edge_m = 1.0, int subdivisions = 8);
 
 // How a scene names a builtin mesh instead of a file: "builtin:cube", "builtin:pyramid".
 inline constexpr std::string_view kBuiltinMeshPrefix = "builtin:";
-inline constexpr std::string_view kBuiltinMeshNames = "\"builtin:cube\", \"builtin:pyramid\", \"builtin:sphere\"";
+inline constexpr std::string_view kBuiltinMeshNames =
+    "\"builtin:cube\", \"builtin:pyramid\", \"builtin:sphere\", \"builtin:cup\"";
 bool is_builtin_mesh_source(std::string_view source);
 // The builtin mesh a source names, at its default size; nullopt for an unknown builtin name.
 std::optional<Mesh> make_builtin_mesh(std::string_view source);

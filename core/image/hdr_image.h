@@ -1,0 +1,22 @@
+// HdrImage: a linear-light RGB float image as read from a Radiance .hdr or OpenEXR file, the
+// common in-memory form of light probes (row 0 at the top, 3 floats per pixel).
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "core/geometry/vec.h"
+
+namespace arpipe {
+
+struct HdrImage {
+  int width = 0, height = 0;
+  std::vector<float> rgb;  // linear RGB, 3 floats per pixel, row-major, row 0 at the top
+
+  Vec3 at(int x, int y) const {
+    const size_t i = 3 * (static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x));
+    return {rgb[i], rgb[i + 1], rgb[i + 2]};
+  }
+};
+
+}  // namespace arpipe
