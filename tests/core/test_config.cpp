@@ -469,5 +469,41 @@ TEST(Config, BlurValuesOutOfRangeAreRefusedNamingFileAndKey) {
                {"test.toml:2:", "'render.max_predicted_uncertainty_deg' expected a number in [0, 180] (degrees)"});
 }
 
+TEST(Config, EnvironmentAndPrtKeysHaveTheirDefaultsAndReadBack) {
+  const Config d;
+  EXPECT_EQ(d.light.environment.layout, "equirect");
+  EXPECT_EQ(d.light.environment.scale, 1.0);
+  EXPECT_EQ(d.light.environment.window, "none");
+  EXPECT_EQ(d.render.prt.samples, 24);
+  EXPECT_EQ(d.render.prt.bands, 3);
+  EXPECT_EQ(d.render.objects.at(0).prt, "shadowed");
+  const Config c = parse_config(
+      "[light]\nsource = \"environment\"\n[light.environment]\nfile = \"probe.exr\"\nlayout = \"angular\"\n"
+      "yaw_deg = 90\nscale = 2.5\nwindow = \"hanning\"\n[render.prt]\nsamples = 40\nbands = 5\ncache_dir = \"c\"\n"
+      "[[render.objects]]\nmesh = \"builtin:cup\"\nprt = \"interreflected\"\n",
+      "e.toml");
+  EXPECT_EQ(c.light.source, "environment");
+  EXPECT_EQ(c.light.environment.file, fs::path("probe.exr"));
+  EXPECT_EQ(c.light.environment.layout, "angular");
+  EXPECT_NEAR(c.light.environment.yaw_rad, kPi / 2, 1e-15);
+  EXPECT_EQ(c.light.environment.scale, 2.5);
+  EXPECT_EQ(c.light.environment.window, "hanning");
+  EXPECT_EQ(c.render.prt.samples, 40);
+  EXPECT_EQ(c.render.prt.bands, 5);
+  EXPECT_EQ(c.render.prt.cache_dir, fs::path("c"));
+  EXPECT_EQ(c.render.objects.at(0).prt, "interreflected");
+}
+
+TEST(Config, EnvironmentAndPrtValuesOutOfRangeAreRefusedNamingFileAndKey) {
+  expect_error("[light]\nsource = \"environment\"\n",
+               {"test.toml:2:", "'light.source'", "light.environment.file to be set"});
+  expect_error("[light.environment]\nlayout = \"fisheye\"\n",
+               {"test.toml:2:", "'light.environment.layout' expected one of \"angular\", \"mirror-ball\", \"equirect\", \"cube-cross\""});
+  expect_error("[light.environment]\nscale = 0\n", {"'light.environment.scale'", "got 0"});
+  expect_error("[render.prt]\nsamples = 1\n", {"'render.prt.samples'", "got 1"});
+  expect_error("[render.prt]\nbands = 9\n", {"'render.prt.bands'", "got 9"});
+  expect_error("[[render.objects]]\nprt = \"ambient\"\n", {"'render.objects[0].prt'"});
+}
+
 }  // namespace
 }  // namespace arpipe

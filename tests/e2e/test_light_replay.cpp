@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/geometry/vec.h"
+#include "core/image/radiance_hdr.h"
 #include "tests/e2e/child_process.h"
 
 namespace fs = std::filesystem;
@@ -123,6 +124,53 @@ TEST(LightReplay, MirrorProbeFindsTheLampThroughTheWholeDaemon) {
     EXPECT_LT(norm(position - lamp), 0.03);
     EXPECT_TRUE(frame["virtual_layer_drawn"].get<bool>());
   }
+}
+
+// An HDR light probe file as the whole light, through the daemon: a constant 0.5 (exact in RGBE)
+// everywhere gives L00 = 0.5 sqrt(4 pi) times light.environment.scale (the texels' solid angles
+// sum to 4 pi to 1e-12, tests/hdr) and the other coefficients 0 every frame, within 1e-3 of L00:
+// each texel adds y_i at its centre times its exact solid angle, the midpoint rule, whose O(h^2)
+// error on the zonal l = 2 term is 2.3e-4 of L00 at 128 rows; a truncated file stops the daemon at
+// configure, naming the file and the key.
+TEST(LightReplay, EnvironmentFileLightsTheObjectsThroughTheWholeDaemon) {
+  const fs::path dir = fs::path(ARPIPE_BINARY_DIR) / "e2e-out" / ("environment-sky-" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  HdrImage sky;
+  sky.width = 256;
+  sky.height = 128;
+  sky.rgb.assign(size_t(sky.width) * sky.height * 3, 0.5f);
+  write_radiance_hdr(dir / "sky.hdr", sky);
+  const std::vector<std::string> environment{"--set", "light.source=\"environment\"",
+                                             "--set", "light.environment.file=\"" + (dir / "sky.hdr").string() + "\"",
+                                             "--set", "light.environment.scale=40.0"};
+  const DaemonRun run = run_arpiped("environment", kConfigs / "probe-indoor.toml", kProbeCapture, environment);
+  ASSERT_EQ(run.exit_code, 0) << run.stderr_text;
+  ASSERT_EQ(run.results.size(), 12u);
+  const double l00 = 0.5 * 40.0 * std::sqrt(4 * M_PI);
+  for (const auto& frame : run.results) {
+    ASSERT_TRUE(frame.contains("light")) << frame.dump();
+    EXPECT_EQ(frame["light"]["source"], "environment");
+    EXPECT_EQ(frame["light"]["state"], "estimated");
+    EXPECT_TRUE(frame["light"]["lights"].empty());
+    for (size_t c = 0; c < 3; ++c) EXPECT_NEAR(frame["light"]["ambient_sh"][0][c].get<double>(), l00, 1e-9 * l00);
+    for (size_t i = 1; i < 9; ++i)
+      for (size_t c = 0; c < 3; ++c) EXPECT_NEAR(frame["light"]["ambient_sh"][i][c].get<double>(), 0.0, 1e-3 * l00);
+    EXPECT_TRUE(frame["virtual_layer_drawn"].get<bool>());
+    EXPECT_EQ(frame["skipped"]["shadow"], "no direct light");
+  }
+  // Cut the file in the middle of its pixels.
+  const std::string text = [&] {
+    std::ifstream in(dir / "sky.hdr", std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  }();
+  std::ofstream(dir / "cut.hdr", std::ios::binary) << text.substr(0, text.size() / 2);
+  std::vector<std::string> cut = environment;
+  cut[3] = "light.environment.file=\"" + (dir / "cut.hdr").string() + "\"";
+  const DaemonRun bad = run_arpiped("environment-cut", kConfigs / "probe-indoor.toml", kProbeCapture, cut);
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.stderr_text.find("light.environment.file"), std::string::npos) << bad.stderr_text;
+  EXPECT_NE(bad.stderr_text.find("cut.hdr"), std::string::npos) << bad.stderr_text;
+  fs::remove_all(dir);
 }
 
 }  // namespace
