@@ -52,11 +52,13 @@ std::vector<float> transfer_for(const Config& config, const std::string& mesh_so
   const auto start = std::chrono::steady_clock::now();
   const PrtLoad load = load_or_bake_prt(mesh, settings, cache_dir);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  // Baking is expected once per mesh (info); a transfer that could not be cached is baked again at
+  // every start (a warning).
   if (load.baked)
-    log::info("prt: baked {} transfer of {} ({} vertices, {} directions) in {:.2f} s{}", prt, mesh_source,
+    log::info("prt: baked {} transfer of {} ({} vertices, {} directions) in {:.2f} s{} ({})", prt, mesh_source,
               mesh.vertex_count(), settings.samples_per_axis * settings.samples_per_axis, seconds,
-              load.file.empty() ? std::string() : fmt::format(" into {}", load.file.string()));
-  if (!load.note.empty()) log::warn("prt: {}: {}", mesh_source, load.note);
+              load.file.empty() ? std::string() : fmt::format(" into {}", load.file.string()), load.note);
+  if (load.note.find("not cached") != std::string::npos) log::warn("prt: {}: {}", mesh_source, load.note);
   const size_t count = size_t(load.transfer.bands * load.transfer.bands);
   std::vector<float> first9;
   first9.reserve(9 * mesh.vertex_count());

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "apps/arpipe/commands.h"
+#include "apps/arpipe/prt_runtime_cost.h"
 #include "core/light/sh_basis.h"
 #include "render/prt/prt_bake.h"
 #include "render/prt/prt_test_meshes.h"
@@ -32,7 +33,9 @@ constexpr const char* kUsage =
     "  --reference N     samples per axis of the shadowed and interreflected reference (default 256);\n"
     "                    the unshadowed reference is the closed form A_l / pi y_i(n)\n"
     "  --subdivisions N  grid per face of the box (default 8: 405 vertices)\n"
-    "  --threads N       bake threads (default: every core)\n";
+    "  --threads N       bake threads (default: every core)\n"
+    "  --frames N        then the run-time cost: the render stage with PRT against per-pixel Lambert\n"
+    "                    + SH irradiance on the same meshes, N frames each (default 40; 0: skip)\n";
 
 // The test lighting, radiance SH in the object frame (z up), 3 bands: Ramamoorthi and Hanrahan's
 // Grace Cathedral coefficients (docs: reference/rendering.md section 3), same basis convention.
@@ -100,7 +103,7 @@ std::vector<double> analytic_unshadowed(const Mesh& mesh) {
 
 int run_bench_prt(const Args& args) {
   std::vector<int> sample_counts{4, 8, 16, 32, 64};
-  int reference_samples = 256, subdivisions = 8, threads = 0;
+  int reference_samples = 256, subdivisions = 8, threads = 0, runtime_frames = 40;
   try {
     for (size_t i = 0; i < args.size(); ++i) {
       const auto value = [&]() -> const std::string& {
@@ -117,6 +120,8 @@ int run_bench_prt(const Args& args) {
         subdivisions = std::stoi(value());
       } else if (args[i] == "--threads") {
         threads = std::stoi(value());
+      } else if (args[i] == "--frames") {
+        runtime_frames = std::stoi(value());
       } else if (args[i] == "--help" || args[i] == "-h") {
         std::fputs(kUsage, stdout);
         return 0;
@@ -131,6 +136,7 @@ int run_bench_prt(const Args& args) {
       throw std::invalid_argument("--reference must be in [1, 4096]");
     if (subdivisions < 1 || subdivisions > 256) throw std::invalid_argument("--subdivisions must be in [1, 256]");
     if (threads < 0 || threads > 1024) throw std::invalid_argument("--threads must be in [0, 1024]");
+    if (runtime_frames < 0 || runtime_frames > 10000) throw std::invalid_argument("--frames must be in [0, 10000]");
   } catch (const std::exception& e) {
     std::fprintf(stderr, "arpipe bench prt: %s\n%s", e.what(), kUsage);
     return 2;
@@ -183,6 +189,7 @@ int run_bench_prt(const Args& args) {
                     e.transfer_rms, e.transfer_max, e.radiance_rms, e.radiance_max);
         std::fflush(stdout);
       }
+    if (runtime_frames > 0) print_prt_runtime_cost(runtime_frames);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "arpipe bench prt: %s\n", e.what());
     return 1;

@@ -146,7 +146,7 @@ struct ShadowConfig {
 // The precomputed radiance transfer bake (render/prt): run once per mesh and kept in a cache
 // keyed by the mesh's content.
 struct PrtConfig {
-  int samples = 24;                       // per axis of the stratified sphere samples (samples^2 rays)
+  int samples = 32;                       // per axis of the stratified sphere samples (samples^2 rays)
   int bands = 3;                          // baked bands, 3..8 (the shader uses the first 3)
   std::filesystem::path cache_dir;        // empty: $XDG_CACHE_HOME/arpipe/prt or ~/.cache/arpipe/prt
 

@@ -474,7 +474,7 @@ TEST(Config, EnvironmentAndPrtKeysHaveTheirDefaultsAndReadBack) {
   EXPECT_EQ(d.light.environment.layout, "equirect");
   EXPECT_EQ(d.light.environment.scale, 1.0);
   EXPECT_EQ(d.light.environment.window, "none");
-  EXPECT_EQ(d.render.prt.samples, 24);
+  EXPECT_EQ(d.render.prt.samples, 32);
   EXPECT_EQ(d.render.prt.bands, 3);
   EXPECT_EQ(d.render.objects.at(0).prt, "shadowed");
   const Config c = parse_config(
