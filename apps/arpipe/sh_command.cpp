@@ -9,6 +9,7 @@
 #include <string>
 
 #include "apps/arpipe/commands.h"
+#include "apps/arpipe/parse_number.h"
 #include "core/image/hdr_file.h"
 #include "core/image/openexr_file.h"
 #include "core/image/radiance_hdr.h"
@@ -44,13 +45,6 @@ constexpr const char* kUsage =
 int usage_error(const std::string& message) {
   fmt::print(stderr, "arpipe sh: {}\n{}", message, kUsage);
   return 2;
-}
-
-std::optional<double> parse_number(const std::string& text) {
-  double v = 0;
-  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
-  if (ec != std::errc() || end != text.data() + text.size() || !std::isfinite(v)) return std::nullopt;
-  return v;
 }
 
 std::optional<Vec3> parse_direction(const std::string& text) {

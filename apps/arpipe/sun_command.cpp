@@ -11,6 +11,7 @@
 #include <string>
 
 #include "apps/arpipe/commands.h"
+#include "apps/arpipe/parse_number.h"
 #include "core/light/civil_time.h"
 #include "core/light/delta_t.h"
 #include "core/light/sun_direction.h"
@@ -34,13 +35,6 @@ constexpr const char* kUsage =
 int usage_error(const std::string& message) {
   fmt::print(stderr, "arpipe sun: {}\n{}", message, kUsage);
   return 2;
-}
-
-std::optional<double> parse_number(const std::string& text) {
-  double v = 0;
-  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
-  if (ec != std::errc() || end != text.data() + text.size() || !std::isfinite(v)) return std::nullopt;
-  return v;
 }
 
 void print_direction(const char* label, const Vec3& v) {

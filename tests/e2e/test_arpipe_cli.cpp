@@ -2,11 +2,14 @@
 // with a message naming the file, never a crash.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 
 #include "capture/recording/recording_reader.h"
 #include "capture/recording/recording_writer.h"
+#include "core/image/radiance_hdr.h"
 #include "tests/e2e/child_process.h"
 
 namespace fs = std::filesystem;
@@ -177,6 +180,77 @@ TEST_F(ArpipeCli, UnknownCommandIsAUsageError) {
   std::string err;
   EXPECT_EQ(run({"frobnicate"}, nullptr, &err), 2);
   EXPECT_NE(err.find("frobnicate"), std::string::npos) << err;
+}
+
+// The numbers after "]: [" on the first line containing `label`.
+std::vector<double> numbers_after(const std::string& text, const std::string& label) {
+  std::vector<double> out;
+  const size_t line = text.find(label);
+  if (line == std::string::npos) return out;
+  const char* p = text.c_str() + text.find("]: [", line) + 4;
+  for (int i = 0; i < 3; ++i) {
+    char* end = nullptr;
+    out.push_back(std::strtod(p, &end));
+    p = end + 1;
+  }
+  return out;
+}
+
+// A constant probe of radiance 0.5 (exact in RGBE): L00 = 0.5 sqrt(4 pi) = 1.77245 and, at any
+// normal, E = pi L = 1.5708; 1e-4 relative: the per-texel sum is the midpoint rule, whose error on
+// the zonal l = 2 term is 5e-5 of L00 at 256 rows.
+TEST_F(ArpipeCli, ShPrintsTheCoefficientsAndIrradianceOfAProbeAndWritesItsReconstruction) {
+  HdrImage sky;
+  sky.width = 512;
+  sky.height = 256;
+  sky.rgb.assign(size_t(sky.width) * sky.height * 3, 0.5f);
+  write_radiance_hdr(dir_ / "sky.hdr", sky);
+  std::string out, err;
+  ASSERT_EQ(run({"sh", "--probe", (dir_ / "sky.hdr").string(), "--layout", "equirect", "--normal", "0.3,-0.2,1",
+                 "--reconstruct", (dir_ / "back.hdr").string()},
+                &out, &err),
+            0)
+      << err;
+  EXPECT_NE(out.find("    0   0   0       1.77245      1.77245      1.77245"), std::string::npos) << out;
+  const std::vector<double> e = numbers_after(out, "irradiance at normal");
+  ASSERT_EQ(e.size(), 3u) << out;
+  for (double v : e) EXPECT_NEAR(v, M_PI * 0.5, 1e-4 * M_PI * 0.5) << out;
+  const HdrImage back = read_radiance_hdr(dir_ / "back.hdr");
+  ASSERT_EQ(back.width, 512);
+  // The 3-band reconstruction of a constant is the constant, within the same 1e-4 and RGBE's
+  // truncation of up to 2^-8 of the value.
+  for (float v : back.rgb) EXPECT_NEAR(v, 0.5, 0.5 * (1e-4 + 1.0 / 256));
+}
+
+TEST_F(ArpipeCli, ShRefusesAProbeWhoseShapeDoesNotFitTheLayoutNamingTheFile) {
+  HdrImage sky;
+  sky.width = 64;
+  sky.height = 32;
+  sky.rgb.assign(size_t(sky.width) * sky.height * 3, 0.5f);
+  write_radiance_hdr(dir_ / "wide.hdr", sky);
+  std::string out, err;
+  EXPECT_EQ(run({"sh", "--probe", (dir_ / "wide.hdr").string(), "--layout", "angular"}, &out, &err), 1);
+  EXPECT_NE(err.find("wide.hdr"), std::string::npos) << err;
+  EXPECT_EQ(run({"sh", "--probe", (dir_ / "wide.hdr").string(), "--layout", "fisheye"}, &out, &err), 2);
+  EXPECT_NE(err.find("--layout"), std::string::npos) << err;
+}
+
+TEST_F(ArpipeCli, BakeCachesTheTransferAndDoesNotBakeAnUnchangedMeshAgain) {
+  const fs::path cache = dir_ / "cache";
+  std::string out, err;
+  ASSERT_EQ(run({"bake", "builtin:cup", "--samples", "8", "--cache-dir", cache.string()}, &out, &err), 0) << err;
+  EXPECT_NE(out.find("baked in"), std::string::npos) << out;
+  ASSERT_EQ(std::distance(fs::directory_iterator(cache), fs::directory_iterator()), 1);
+  ASSERT_EQ(run({"bake", "builtin:cup", "--samples", "8", "--cache-dir", cache.string()}, &out, &err), 0) << err;
+  EXPECT_NE(out.find("up to date (not baked)"), std::string::npos) << out;
+  // Other settings are another key: a second file.
+  ASSERT_EQ(run({"bake", "builtin:cup", "--samples", "8", "--kind", "unshadowed", "--cache-dir", cache.string()}, &out,
+                &err),
+            0)
+      << err;
+  EXPECT_EQ(std::distance(fs::directory_iterator(cache), fs::directory_iterator()), 2);
+  EXPECT_EQ(run({"bake", (dir_ / "missing.gltf").string(), "--cache-dir", cache.string()}, &out, &err), 1);
+  EXPECT_NE(err.find("missing.gltf"), std::string::npos) << err;
 }
 
 }  // namespace
