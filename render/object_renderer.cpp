@@ -54,16 +54,20 @@ uniform vec4 u_light_position;   // w = 1: a lamp there (the direction is per po
 uniform vec3 u_light_color;
 uniform vec3 u_ambient;
 uniform vec3 u_ambient_sh[9];
+uniform vec3 u_radiance_sh[9];   // the environment's radiance (world), for the glossy reflection
+uniform float u_specular;        // its weight
+uniform vec3 u_camera_world;     // the eye, for the reflection direction
 uniform float u_exposure_scale;
 uniform bool u_shadow_catcher;
 out vec4 out_color;              // linear, premultiplied alpha
 {shadow_lookup}
-vec3 ambient_at(vec3 n) {{
-  return u_ambient + 0.282095 * u_ambient_sh[0]
-       + 0.488603 * (n.y * u_ambient_sh[1] + n.z * u_ambient_sh[2] + n.x * u_ambient_sh[3])
-       + 1.092548 * (n.x * n.y * u_ambient_sh[4] + n.y * n.z * u_ambient_sh[5] + n.x * n.z * u_ambient_sh[7])
-       + 0.315392 * (3.0 * n.z * n.z - 1.0) * u_ambient_sh[6] + 0.546274 * (n.x * n.x - n.y * n.y) * u_ambient_sh[8];
+vec3 sh9_at(vec3 c[9], vec3 n) {{
+  return 0.282095 * c[0] + 0.488603 * (n.y * c[1] + n.z * c[2] + n.x * c[3])
+       + 1.092548 * (n.x * n.y * c[4] + n.y * n.z * c[5] + n.x * n.z * c[7])
+       + 0.315392 * (3.0 * n.z * n.z - 1.0) * c[6] + 0.546274 * (n.x * n.x - n.y * n.y) * c[8];
 }}
+
+vec3 ambient_at(vec3 n) {{ return u_ambient + sh9_at(u_ambient_sh, n); }}
 
 void main() {{
   vec3 normal = normalize(v_normal_world);
@@ -82,7 +86,13 @@ void main() {{
     return;
   }}
   vec3 environment = u_prt ? v_prt_radiance : ambient_at(normal);
-  vec3 rgb = u_base_color.rgb * max(environment + u_light_color * (lambert * visibility), 0.0) * u_exposure_scale;
+  vec3 rgb = u_base_color.rgb * max(environment + u_light_color * (lambert * visibility), 0.0);
+  if (u_specular > 0.0) {{
+    // Seed 002's reflection mapping, from the band-limited environment: a glossy, not a mirror, look.
+    vec3 reflected = reflect(normalize(v_world - u_camera_world), normal);
+    rgb += u_specular * max(sh9_at(u_radiance_sh, reflected), 0.0);
+  }}
+  rgb *= u_exposure_scale;
   out_color = vec4(rgb * u_base_color.a, u_base_color.a);
 }}
 )glsl";
@@ -199,6 +209,9 @@ void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, c
   for (size_t i = 0; i < 9; ++i)
     for (size_t c = 0; c < 3; ++c) sh[i * 3 + c] = static_cast<float>(lighting.ambient_sh[i][c]);
   glUniform3fv(program.uniform("u_ambient_sh"), 9, sh.data());
+  for (size_t i = 0; i < 9; ++i)
+    for (size_t c = 0; c < 3; ++c) sh[i * 3 + c] = static_cast<float>(lighting.radiance_sh[i][c]);
+  glUniform3fv(program.uniform("u_radiance_sh"), 9, sh.data());
   glUniform1f(program.uniform("u_exposure_scale"), static_cast<float>(lighting.exposure_scale));
   if (lighting.shadow) set_shadow_lookup_uniforms(program, *lighting.shadow, 1);
   const GLint world_from_object_rotation = program.uniform("u_world_from_object_rotation");
@@ -207,6 +220,8 @@ void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, c
   const GLint base_color = program.uniform("u_base_color");
   const GLint shadow_catcher = program.uniform("u_shadow_catcher");
   const GLint prt = program.uniform("u_prt");
+  const GLint specular = program.uniform("u_specular");
+  const GLint camera_world = program.uniform("u_camera_world");
   const GLint prt_light = program.uniform("u_prt_light");
   for (const ObjectAtInstant& item : objects) {
     set_row_poses(program, "pose", item.poses, item.object->scale);
@@ -215,6 +230,12 @@ void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, c
     set_vec3(world_from_object_translation, item.object->T_world_object.translation());
     glUniform1f(object_scale, static_cast<float>(item.object->scale));
     glUniform1i(shadow_catcher, item.object->shadow_catcher ? 1 : 0);
+    glUniform1f(specular, item.object->shadow_catcher ? 0.0f : static_cast<float>(item.object->specular));
+    if (item.object->specular > 0 && !item.poses.T_cam_object.empty()) {
+      // The eye of the middle row: rows differ by far less than the reflection's blur.
+      const SE3& T_cam_object = item.poses.T_cam_object[item.poses.T_cam_object.size() / 2];
+      set_vec3(camera_world, item.object->T_world_object * T_cam_object.inverse().translation());
+    }
     const bool use_prt = item.object->mesh->has_transfer() && !item.object->shadow_catcher;
     glUniform1i(prt, use_prt ? 1 : 0);
     if (use_prt) {

@@ -89,6 +89,7 @@ std::vector<RenderObject> load_render_objects(const Config& config) {
     out.mesh_source = object.mesh;
     out.mesh = found->second.gpu;
     out.scale = object.scale;
+    out.specular = object.specular;
     out.bounds = scaled(found->second.bounds, object.scale);
     out.T_world_object = SE3::from_rt({0, 0, object.yaw_rad}, object.position_m);
     if (is_builtin_mesh_source(object.mesh))

@@ -25,6 +25,7 @@ struct RenderObject {
   // The real ground under the objects (render/shadow_receiver.h): drawn as the shadow's
   // darkening, never as a surface, and it casts nothing.
   bool shadow_catcher = false;
+  double specular = 0;  // weight of the environment's glossy reflection (config)
 };
 
 

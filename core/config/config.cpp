@@ -440,7 +440,7 @@ void read_render(const ConfigReader& r, const toml::table& t, RenderConfig& out)
     for (size_t i = 0; i < objects->size(); ++i) {
       const toml::table& object_table = *(*objects)[i].as_table();
       const std::string op = fmt::format("render.objects[{}].", i);
-      r.check_keys(object_table, op, {"mesh", "position_m", "yaw_deg", "scale", "color", "prt"}, "[[render.objects]]");
+      r.check_keys(object_table, op, {"mesh", "position_m", "yaw_deg", "scale", "color", "prt", "specular"}, "[[render.objects]]");
       SceneObject object;
       r.read(object_table, op, "mesh", object.mesh);
       if (object.mesh.empty()) r.fail(*object_table.get("mesh"), op + "mesh", "\"builtin:cube\", \"builtin:pyramid\" or a glTF file");
@@ -449,6 +449,8 @@ void read_render(const ConfigReader& r, const toml::table& t, RenderConfig& out)
       r.read(object_table, op, "scale", object.scale, positive, "a number > 0");
       r.read(object_table, op, "color", object.color, non_negative, "numbers >= 0");
       r.read(object_table, op, "prt", object.prt, {"off", "unshadowed", "shadowed", "interreflected"});
+      r.read(object_table, op, "specular", object.specular, [](double v) { return v >= 0 && v <= 1; },
+             "a number in [0, 1]");
       out.objects.push_back(object);
     }
   }
@@ -830,6 +832,7 @@ std::string default_config_toml() {
     entry("scale", f(object.scale), "> 0");
     entry("color", vec(object.color), "linear base colour of builtin meshes, >= 0");
     entry("prt", s(object.prt), "environment light: \"off\", \"unshadowed\", \"shadowed\" or \"interreflected\"");
+    entry("specular", f(object.specular), "[0, 1]: glossy reflection of the environment, added untinted");
   }
 
   out += "\n[sinks.png]\n";

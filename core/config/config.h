@@ -104,6 +104,9 @@ struct SceneObject {
   // precomputed radiance transfer baked per vertex ([render.prt]): "unshadowed", "shadowed"
   // (self-shadowing) or "interreflected" (plus one grey bounce).
   std::string prt = "shadowed";
+  // Weight of a glossy reflection of the environment (the 3-band radiance along the mirror
+  // direction, added untinted), [0, 1]; 0: purely diffuse.
+  double specular = 0;
 
   bool operator==(const SceneObject&) const = default;
 };

@@ -503,6 +503,7 @@ TEST(Config, EnvironmentAndPrtValuesOutOfRangeAreRefusedNamingFileAndKey) {
   expect_error("[render.prt]\nsamples = 1\n", {"'render.prt.samples'", "got 1"});
   expect_error("[render.prt]\nbands = 9\n", {"'render.prt.bands'", "got 9"});
   expect_error("[[render.objects]]\nprt = \"ambient\"\n", {"'render.objects[0].prt'"});
+  expect_error("[[render.objects]]\nspecular = 1.5\n", {"'render.objects[0].specular' expected a number in [0, 1]"});
 }
 
 }  // namespace
