@@ -751,7 +751,7 @@ std::string default_config_toml() {
 
   out += "\n[light]                        # where the light comes from\n";
   entry("source", s(d.light.source),
-        "\"fixed\" (render.light_*), \"probe\" (a probe sphere in view) or \"sun\" (place and time)");
+        "\"fixed\" (render.light_*), \"probe\" (a probe sphere in view), \"sun\" (place and time) or \"environment\" (an HDR probe file)");
   entry("response", s(d.light.response), "camera response: \"srgb\", \"linear\" or \"gamma:<g>\"");
   entry("smoothing_s", f(d.light.smoothing_s), "[0, 60]: time constant of the temporal smoothing");
   entry("ground_albedo", vec(d.light.ground_albedo),
