@@ -166,6 +166,17 @@ struct Errors {
   int pixels = 0;
 };
 
+// The sampled pixels as a small linear image, so that a person can look at what was compared
+// (build/test-prt-sky/cup-*.hdr, in any HDR viewer).
+void write_sampled(const std::string& name, const std::vector<Vec3>& pixels) {
+  HdrImage image;
+  image.width = (kWidth + kStep - 1) / kStep;
+  image.height = (kHeight + kStep - 1) / kStep;
+  for (const Vec3& p : pixels)
+    for (double c : p) image.rgb.push_back(static_cast<float>(std::max(0.0, c)));
+  write_radiance_hdr(fs::path(ARPIPE_BINARY_DIR) / "test-prt-sky" / (name + ".hdr"), image);
+}
+
 double luminance(const Vec3& c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
 
 Errors compare(const std::vector<Vec3>& rendered, const Truth& truth, const std::vector<bool>& selected) {
@@ -232,6 +243,9 @@ TEST(PrtAgainstSimulator, ShadowedTransferIsCloserThanUnshadowedInsideAConcaveMo
     }
   const std::vector<Vec3> unshadowed = render(object_config("builtin:cup", "unshadowed"), pose);
   const std::vector<Vec3> shadowed = render(object_config("builtin:cup", "shadowed"), pose);
+  write_sampled("cup-ray-traced", truth.radiance);
+  write_sampled("cup-prt-unshadowed", unshadowed);
+  write_sampled("cup-prt-shadowed", shadowed);
   const Errors pit_unshadowed = compare(unshadowed, truth, in_pit), pit_shadowed = compare(shadowed, truth, in_pit);
   const Errors all_unshadowed = compare(unshadowed, truth, all), all_shadowed = compare(shadowed, truth, all);
   ASSERT_GT(pit_shadowed.pixels, 100) << "the view should look into the pit";
