@@ -1,6 +1,5 @@
 #include "core/light/sh_irradiance.h"
 
-#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -34,21 +33,7 @@ ShRgb sh_irradiance_coefficients(const ShRgb& radiance) {
 }
 
 Vec3 sh_irradiance(const ShRgb& radiance, const Vec3& unit_normal) {
-  if (radiance.bands < 1) return {0, 0, 0};
-  std::array<double, kMaxShBands * kMaxShBands> y;
-  sh_basis(radiance.bands, unit_normal, y);
-  Vec3 e{0, 0, 0};
-  for (int l = 0; l < radiance.bands; ++l) {
-    const double a = sh_cosine_lobe_constant(l);
-    if (a == 0) continue;
-    Vec3 band{0, 0, 0};
-    for (int m = -l; m <= l; ++m) {
-      const size_t i = size_t(sh_index(l, m));
-      band = band + y[i] * radiance.c[i];
-    }
-    e = e + a * band;
-  }
-  return e;
+  return sh_eval(sh_irradiance_coefficients(radiance), unit_normal);
 }
 
 ShRgb9 to_sh9(const ShRgb& sh) {

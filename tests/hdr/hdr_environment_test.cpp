@@ -17,6 +17,9 @@
 namespace arpipe {
 namespace {
 
+using hdr_test::angle_between;
+using hdr_test::random_direction;
+
 constexpr double kPi = std::numbers::pi;
 constexpr double kBlank = 1e6;  // written into texels outside the layout: reading one shows at once
 constexpr std::array<ProbeLayout, 4> kLayouts = {ProbeLayout::AngularMap, ProbeLayout::MirrorBall,
@@ -25,16 +28,6 @@ constexpr std::array<ProbeLayout, 4> kLayouts = {ProbeLayout::AngularMap, ProbeL
 double f(const Vec3& d) { return 1 + d[0] + 2 * d[2] * d[2]; }
 // |grad f| on the sphere <= |grad x| + |grad 2 z^2| <= 1 + 4 |z| sqrt(1 - z^2) <= 1 + 2 = 3.
 constexpr double kGradientBound = 3;
-
-double angle_between(const Vec3& a, const Vec3& b) { return std::atan2(norm(cross(a, b)), dot(a, b)); }
-
-Vec3 random_direction(std::mt19937_64& rng) {
-  std::normal_distribution<double> g;
-  for (;;) {
-    const Vec3 v{g(rng), g(rng), g(rng)};
-    if (norm(v) > 1e-6) return normalized(v);
-  }
-}
 
 std::array<int, 2> size_of(ProbeLayout layout, int n) {
   switch (layout) {

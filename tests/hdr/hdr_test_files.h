@@ -4,17 +4,32 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <random>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "core/geometry/vec.h"
 #include "core/scene/asset_error.h"
 
 namespace arpipe::hdr_test {
+
+// The angle between two directions (atan2: accurate near 0 and pi).
+inline double angle_between(const Vec3& a, const Vec3& b) { return std::atan2(norm(cross(a, b)), dot(a, b)); }
+
+// A direction uniform on the sphere.
+inline Vec3 random_direction(std::mt19937_64& rng) {
+  std::normal_distribution<double> g;
+  for (;;) {
+    const Vec3 v{g(rng), g(rng), g(rng)};
+    if (norm(v) > 1e-6) return normalized(v);
+  }
+}
 
 // A fresh directory under the build tree named after the running test (tests run in parallel).
 inline std::filesystem::path scratch_dir() {

@@ -15,6 +15,9 @@
 namespace arpipe {
 namespace {
 
+using hdr_test::angle_between;
+using hdr_test::random_direction;
+
 constexpr double kPi = std::numbers::pi;
 constexpr std::array<ProbeLayout, 4> kLayouts = {ProbeLayout::AngularMap, ProbeLayout::MirrorBall,
                                                  ProbeLayout::Equirectangular, ProbeLayout::CubeCross};
@@ -27,16 +30,6 @@ Size size_of(ProbeLayout layout, int n) {
     case ProbeLayout::Equirectangular: return {2 * n, n};
     case ProbeLayout::CubeCross: return {3 * n, 4 * n};
     default: return {n, n};
-  }
-}
-
-double angle_between(const Vec3& a, const Vec3& b) { return std::atan2(norm(cross(a, b)), dot(a, b)); }
-
-Vec3 random_direction(std::mt19937_64& rng) {
-  std::normal_distribution<double> g;
-  for (;;) {
-    const Vec3 v{g(rng), g(rng), g(rng)};
-    if (norm(v) > 1e-6) return normalized(v);
   }
 }
 
