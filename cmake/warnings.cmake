@@ -8,3 +8,13 @@ if(ARPIPE_SANITIZE)
   add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
   add_link_options(-fsanitize=address,undefined)
 endif()
+if(ARPIPE_FUZZ)
+  # libFuzzer (docs/FUZZING.md): every library gets coverage instrumentation and the sanitizers;
+  # the targets in tests/fuzz link -fsanitize=fuzzer themselves (it brings libFuzzer's main).
+  if(NOT CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
+    message(FATAL_ERROR "ARPIPE_FUZZ needs clang (CC=clang-14 CXX=clang++-14): libFuzzer is part of clang")
+  endif()
+  add_compile_options(-fsanitize=fuzzer-no-link,address,undefined -fno-omit-frame-pointer
+                      -fno-sanitize-recover=undefined)
+  add_link_options(-fsanitize=address,undefined)
+endif()
