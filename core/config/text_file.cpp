@@ -1,30 +1,17 @@
+// Whole text files through the regular-file-only reader, the failure turned into a reason.
 #include "core/config/text_file.h"
 
-#include <cerrno>
-#include <cstring>
-#include <fstream>
-#include <sstream>
+#include "core/config/regular_file.h"
 
 namespace arpipe {
 
 std::optional<std::string> read_text_file(const std::filesystem::path& path, std::string& why) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) {
-    why = "it is a directory";
+  try {
+    return read_regular_file(path, "text file", kMaxTextFileBytes);
+  } catch (const FileAccessError& e) {
+    why = e.reason();
     return std::nullopt;
   }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    why = std::strerror(errno);
-    return std::nullopt;
-  }
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) {
-    why = std::strerror(errno);
-    return std::nullopt;
-  }
-  return text.str();
 }
 
 }  // namespace arpipe
