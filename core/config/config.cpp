@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <charconv>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -16,6 +17,7 @@
 #include <fstream>
 #include <functional>
 #include <limits>
+#include <map>
 #include <numbers>
 #include <optional>
 #include <set>
@@ -31,6 +33,9 @@ namespace {
 
 constexpr double kRadiansPerDegree = std::numbers::pi / 180.0;
 constexpr const char* kOverridePrefix = "override '";
+// Drivers disagree about what their timestamps mean by a frame or two; an hour is far beyond any
+// real offset and keeps every exposure time plus the offset inside int64 nanoseconds.
+constexpr int64_t kMaxTimestampOffsetNs = 3'600'000'000'000;
 
 std::string join(const std::vector<std::string>& items) {
   std::string out;
@@ -53,13 +58,105 @@ std::string format_toml_float(double value) {
   return text;
 }
 
+std::string_view trim(std::string_view text) {
+  while (!text.empty() && std::isspace(static_cast<unsigned char>(text.front()))) text.remove_prefix(1);
+  while (!text.empty() && std::isspace(static_cast<unsigned char>(text.back()))) text.remove_suffix(1);
+  return text;
+}
+
+// A TOML basic string; control characters are escaped, so the text stays on one line.
 std::string toml_string(std::string_view text) {
   std::string out = "\"";
   for (const char c : text) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += c;
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (c == '\n') {
+      out += "\\n";
+    } else if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
+      out += fmt::format("\\u{:04X}", static_cast<unsigned char>(c));
+    } else {
+      out += c;
+    }
   }
   return out + "\"";
+}
+
+// Text for a message: control characters shown as escapes, so a value cannot start a new line.
+std::string printable(std::string_view text) {
+  std::string out;
+  for (const char c : text) {
+    if (c == '\n') out += "\\n";
+    else if (c == '\r') out += "\\r";
+    else if (c == '\t') out += "\\t";
+    else if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) out += fmt::format("\\x{:02x}", static_cast<unsigned char>(c));
+    else out += c;
+  }
+  return out;
+}
+
+// toml++ rejects numbers beyond 64 bits as syntax errors ("'1e400' could not be interpreted as a
+// value", "... is not representable in 64 bits"); this says what is wrong with such a number.
+std::optional<std::string> out_of_range_number(std::string_view description) {
+  const size_t open = description.find('\'');
+  const size_t close = open == std::string_view::npos ? open : description.find('\'', open + 1);
+  if (close == std::string_view::npos) return std::nullopt;
+  const std::string_view token = description.substr(open + 1, close - open - 1);
+  if (description.starts_with("Error while parsing floating-point") &&
+      description.find("could not be interpreted") != std::string_view::npos)
+    return fmt::format("{} is out of range for a 64-bit float (magnitude at most about 1.8e308)", token);
+  if (description.find("is not representable in 64 bits") != std::string_view::npos)
+    return fmt::format("{} is out of range for a 64-bit integer [-9223372036854775808, 9223372036854775807]", token);
+  return std::nullopt;
+}
+
+// The 1-based column where the quoted number of a toml++ description starts on line `line`.
+std::optional<toml::source_index> number_column(std::string_view text, uint32_t line, std::string_view description) {
+  const size_t open = description.find('\'');
+  const size_t close = open == std::string_view::npos ? open : description.find('\'', open + 1);
+  if (close == std::string_view::npos) return std::nullopt;
+  const std::string_view token = description.substr(open + 1, close - open - 1);
+  size_t begin = 0;
+  for (uint32_t number = 1; number < line; ++number) {
+    begin = text.find('\n', begin);
+    if (begin == std::string_view::npos) return std::nullopt;
+    ++begin;
+  }
+  const std::string_view content = text.substr(begin, text.find('\n', begin) - begin);
+  const size_t equals = content.find('=');
+  const size_t at = content.find(token, equals == std::string_view::npos ? 0 : equals);
+  if (at == std::string_view::npos) return std::nullopt;
+  return static_cast<toml::source_index>(at + 1);
+}
+
+// The dotted key assigned on line `line` (1-based) of a TOML text, with the table header above it
+// ("render.lens_canvas_scale", "render.objects[1].scale"): a line scan for messages only.
+std::string key_on_line(std::string_view text, uint32_t line) {
+  std::string table;
+  std::map<std::string, int> array_counts;
+  size_t begin = 0;
+  for (uint32_t number = 1; begin <= text.size(); ++number) {
+    size_t end = text.find('\n', begin);
+    if (end == std::string_view::npos) end = text.size();
+    const std::string_view content = trim(text.substr(begin, end - begin));
+    if (number == line) {
+      const size_t equals = content.find('=');
+      const std::string key(trim(content.substr(0, equals == std::string_view::npos ? 0 : equals)));
+      if (key.empty()) return table;
+      return table.empty() ? key : table + "." + key;
+    }
+    if (content.starts_with("[[")) {
+      const size_t close = content.find("]]");
+      const std::string name(trim(content.substr(2, close == std::string_view::npos ? 0 : close - 2)));
+      table = fmt::format("{}[{}]", name, array_counts[name]++);
+    } else if (content.starts_with("[")) {
+      const size_t close = content.find(']');
+      table = std::string(trim(content.substr(1, close == std::string_view::npos ? 0 : close - 1)));
+    }
+    if (end == text.size()) break;
+    begin = end + 1;
+  }
+  return table;
 }
 
 // ---- The schema walk ----------------------------------------------------------------------------
@@ -242,7 +339,7 @@ void read_source(const ConfigReader& r, const toml::table& t, SourceConfig& out)
   r.read(t, p, "path", out.path);
   r.read(t, p, "pacing", out.pacing, {"timestamps", "fast"});
   r.read(t, p, "loop", out.loop);
-  r.read(t, p, "timestamp_offset_ns", out.timestamp_offset_ns);
+  r.read(t, p, "timestamp_offset_ns", out.timestamp_offset_ns, -kMaxTimestampOffsetNs, kMaxTimestampOffsetNs);
   r.read(t, p, "camera_model", out.camera_model);
   r.read(t, p, "device", out.device);
   r.read(t, p, "camera", out.camera);
@@ -559,12 +656,6 @@ bool looks_like_bare_word(std::string_view value) {
   });
 }
 
-std::string_view trim(std::string_view text) {
-  while (!text.empty() && std::isspace(static_cast<unsigned char>(text.front()))) text.remove_prefix(1);
-  while (!text.empty() && std::isspace(static_cast<unsigned char>(text.back()))) text.remove_suffix(1);
-  return text;
-}
-
 void merge_override(toml::table& target, toml::table& source, const std::string& prefix, const std::string& label);
 
 // "render.objects.0.scale": a table of integer keys, merged into the existing array's elements.
@@ -573,8 +664,9 @@ void merge_override_into_array(toml::array& target, toml::table& source, const s
   for (auto&& [key, value] : source) {
     size_t index = 0;
     const std::string text(key.str());
-    if (text.empty() || !std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; }) ||
-        (index = std::stoul(text)) >= target.size())
+    // from_chars, not stoul: an index of 30 digits is "not an index", not std::out_of_range's "stoul".
+    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), index);
+    if (text.empty() || ec != std::errc() || end != text.data() + text.size() || index >= target.size())
       override_error(label, fmt::format("'{}' has {} elements; '{}' is not an index into it", prefix,
                                         target.size(), text));
     const std::string element = fmt::format("{}[{}]", prefix, index);
@@ -623,8 +715,25 @@ void merge_override(toml::table& target, toml::table& source, const std::string&
   }
 }
 
+// The parsed override must be exactly the one key it names: a chain of single-entry tables down to
+// one value (a newline in the value would otherwise let it add tables of its own).
+bool is_single_assignment(const toml::table& parsed, std::string_view key) {
+  const toml::table* table = &parsed;
+  size_t start = 0;
+  while (true) {
+    const size_t dot = key.find('.', start);
+    const std::string_view part = key.substr(start, dot == std::string_view::npos ? dot : dot - start);
+    if (table->size() != 1 || !table->contains(part)) return false;
+    if (dot == std::string_view::npos) return true;
+    const toml::node* next = table->get(part);
+    if (!next->is_table()) return false;
+    table = next->as_table();
+    start = dot + 1;
+  }
+}
+
 void apply_override(toml::table& root, const std::string& assignment) {
-  const std::string label = fmt::format("{}{}'", kOverridePrefix, assignment);
+  const std::string label = fmt::format("{}{}'", kOverridePrefix, printable(assignment));
   const size_t equals = assignment.find('=');
   if (equals == std::string::npos) override_error(label, "expected section.key=value");
   const std::string_view key = trim(std::string_view(assignment).substr(0, equals));
@@ -633,18 +742,30 @@ void apply_override(toml::table& root, const std::string& assignment) {
   while (true) {
     const size_t dot = key.find('.', start);
     if (!is_bare_key(key.substr(start, dot == std::string_view::npos ? dot : dot - start)))
-      override_error(label, fmt::format("'{}' is not a dotted key such as track.family", key));
+      override_error(label, fmt::format("'{}' is not a dotted key such as track.family", printable(key)));
     if (dot == std::string_view::npos) break;
     start = dot + 1;
   }
+  // One value on one line: a line break (or another control character) could start new tables.
+  const auto control = std::find_if(value.begin(), value.end(), [](char c) {
+    return (static_cast<unsigned char>(c) < 0x20 && c != '\t') || c == 0x7f;
+  });
+  if (control != value.end())
+    override_error(label, fmt::format("the value of '{}' contains {}; an override is exactly one TOML value on one "
+                                      "line (escape it inside a quoted string, e.g. \"a\\nb\")",
+                                      key, *control == '\n' ? "a newline" : "a control character"));
   toml::table parsed;
   try {
     parsed = toml::parse(fmt::format("{} = {}", key, value), std::string_view(label));
   } catch (const toml::parse_error& e) {
+    if (const auto range = out_of_range_number(e.description()))
+      override_error(label, fmt::format("'{}' is out of range: {}", key, *range));
     if (!looks_like_bare_word(value))
       override_error(label, fmt::format("the value is not valid TOML ({}); quote strings", e.description()));
     parsed = toml::parse(fmt::format("{} = {}", key, toml_string(value)), std::string_view(label));
   }
+  if (!is_single_assignment(parsed, key))
+    override_error(label, fmt::format("the value of '{}' is not exactly one TOML value", key));
   merge_override(root, parsed, "", label);
 }
 
@@ -660,6 +781,13 @@ Config parse_config(const std::string& text, const std::string& source_name, con
   try {
     root = toml::parse(text, std::string_view(source_name));
   } catch (const toml::parse_error& e) {
+    if (const auto range = out_of_range_number(e.description())) {
+      // toml++ places the error after the number; the message points at the number itself.
+      toml::source_region where = e.source();
+      where.begin.column = number_column(text, where.begin.line, e.description()).value_or(where.begin.column);
+      throw ConfigError(fmt::format("{}: '{}' is out of range: {}", place_of(where, source_name),
+                                    key_on_line(text, where.begin.line), *range));
+    }
     throw ConfigError(fmt::format("{}: TOML syntax error: {}", place_of(e.source(), source_name), e.description()));
   }
   return parse_table(std::move(root), source_name, overrides);
@@ -698,7 +826,7 @@ std::string default_config_toml() {
   entry("pacing", s(d.source.pacing), "replay: \"timestamps\" (real time) or \"fast\"");
   entry("loop", b(d.source.loop), "replay: start again at the end");
   entry("timestamp_offset_ns", fmt::format("{}", d.source.timestamp_offset_ns),
-        "added to every exposure start of this camera");
+        "added to every exposure start of this camera; within +-1 hour (3600000000000)");
   entry("camera_model", s(d.source.camera_model.string()),
         "a .cameramodel to use instead of the recording's (live: needed to track)");
   entry("device", s(d.source.device), "v4l2: /dev/videoN or a /dev/v4l/by-id or by-path link");
