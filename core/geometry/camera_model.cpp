@@ -19,6 +19,8 @@ extern "C" {
 #include <sstream>
 #include <system_error>
 
+#include "core/config/regular_file.h"
+
 namespace arpipe {
 
 struct CameraModel::Mrcal {
@@ -196,6 +198,13 @@ std::optional<double> parse_finite_number(const std::string& text) {
   return value;
 }
 
+// Nesting of lists and dicts inside the top-level dict: mrcal's files nest 2 deep (a list in a
+// value; optional metadata dicts a little more).
+constexpr int kMaxLiteralDepth = 32;
+// A splined model of 60 x 40 knots is ~150 KB of text; 4 MiB bounds what a hostile file can make
+// the parser and mrcal's reader hold.
+constexpr uint64_t kMaxCameraModelBytes = uint64_t{4} << 20;
+
 class DictLiteralParser {
  public:
   DictLiteralParser(const std::string& text, const std::string& source) : scanner_(text, source) {}
@@ -234,9 +243,13 @@ class DictLiteralParser {
       throw scanner_.error(token.at, fmt::format("expected '{}' {}, got {}", punct, where, describe(token)));
   }
 
-  LiteralValue parse_value(const Token& first) {
+  // depth: lists and dicts around this value; bounded so a file of '[' cannot exhaust the stack.
+  LiteralValue parse_value(const Token& first, int depth = 1) {
     LiteralValue value;
     value.at = first.at;
+    if (depth > kMaxLiteralDepth)
+      throw scanner_.error(first.at, fmt::format("values nested more than {} levels deep (a .cameramodel needs 2)",
+                                                 kMaxLiteralDepth));
     switch (first.kind) {
       case Token::Kind::String: value.kind = LiteralValue::Kind::String; value.text = first.text; return value;
       case Token::Kind::Number: value.kind = LiteralValue::Kind::Number; value.text = first.text; return value;
@@ -249,7 +262,7 @@ class DictLiteralParser {
       value.kind = LiteralValue::Kind::List;
       Token token = scanner_.next();
       while (!(token.kind == Token::Kind::Punct && token.text == close)) {
-        const LiteralValue item = parse_value(token);
+        const LiteralValue item = parse_value(token, depth + 1);
         value.items.push_back(item.kind == LiteralValue::Kind::Number ? parse_finite_number(item.text) : std::nullopt);
         token = scanner_.next();
         if (token.kind == Token::Kind::Punct && token.text == ",") {
@@ -264,9 +277,9 @@ class DictLiteralParser {
       value.kind = LiteralValue::Kind::Dict;
       Token token = scanner_.next();
       while (!(token.kind == Token::Kind::Punct && token.text == "}")) {
-        parse_value(token);
+        parse_value(token, depth + 1);
         expect(":", "after a key");
-        parse_value(scanner_.next());
+        parse_value(scanner_.next(), depth + 1);
         token = scanner_.next();
         if (token.kind == Token::Kind::Punct && token.text == ",") {
           token = scanner_.next();
@@ -374,15 +387,13 @@ CameraModel CameraModel::pinhole(double fx, double fy, double cx, double cy, int
 }
 
 CameraModel CameraModel::load(const std::filesystem::path& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec))
-    throw CameraModelError(fmt::format("{}: cannot read camera model: it is a directory", path.string()));
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw CameraModelError(fmt::format("{}: cannot open camera model: {}", path.string(), std::strerror(errno)));
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw CameraModelError(fmt::format("{}: cannot read camera model: {}", path.string(), std::strerror(errno)));
-  return parse(text.str(), path.string());
+  std::string text;
+  try {
+    text = read_regular_file(path, "camera model", kMaxCameraModelBytes);
+  } catch (const FileAccessError& e) {
+    throw CameraModelError(e.what());
+  }
+  return parse(text, path.string());
 }
 
 CameraModel CameraModel::parse(const std::string& text, const std::string& source_name) {
