@@ -8,8 +8,9 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
-#include <fstream>
+#include <unistd.h>
 
+#include "core/config/regular_file.h"
 #include "core/image/openexr_file.h"
 #include "core/image/radiance_hdr.h"
 #include "core/scene/asset_error.h"
@@ -19,9 +20,21 @@ namespace arpipe {
 HdrImage read_hdr_image(const std::filesystem::path& file) {
   std::array<char, 4> magic{};
   {
-    std::ifstream in(file, std::ios::binary);
-    if (!in) throw AssetError(fmt::format("{}: cannot open: {}", file.string(), std::strerror(errno)));
-    in.read(magic.data(), magic.size());
+    // Regular files only: a FIFO would block here, a device never end.
+    int fd = -1;
+    try {
+      fd = open_regular_file(file, "HDR image");
+    } catch (const FileAccessError& e) {
+      throw AssetError(e.what());
+    }
+    size_t got = 0;
+    while (got < magic.size()) {
+      const ssize_t n = ::read(fd, magic.data() + got, magic.size() - got);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) break;
+      got += size_t(n);
+    }
+    ::close(fd);
   }
   HdrImage image;
   if (magic[0] == '#' && magic[1] == '?')

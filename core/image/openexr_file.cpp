@@ -9,6 +9,8 @@
 #include <OpenEXR/ImfHeader.h>
 #include <OpenEXR/ImfInputFile.h>
 #include <OpenEXR/ImfRgbaFile.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -18,6 +20,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/config/regular_file.h"
 #include "core/image/hdr_file.h"
 #include "core/scene/asset_error.h"
 
@@ -187,6 +190,11 @@ HdrImage read_through_rgba(Imf::RgbaInputFile& file) {
 
 HdrImage read_openexr(const std::filesystem::path& path) {
   const std::string name = path.string();
+  try {
+    ::close(open_regular_file(path, "OpenEXR image"));  // before any stream opens it: a FIFO would block
+  } catch (const FileAccessError& e) {
+    throw AssetError(e.what());
+  }
   ExrHeaderCheck(path, name).run();
   try {
     bool rgb = false;

@@ -14,6 +14,7 @@
 #include <fstream>
 #include <string_view>
 
+#include "core/config/regular_file.h"
 #include "core/image/hdr_file.h"
 #include "core/scene/asset_error.h"
 
@@ -22,6 +23,9 @@ namespace {
 
 constexpr int kMaxSide = 32768;
 constexpr int64_t kMaxPixels = int64_t{1} << 28;
+// Flat scanlines of the largest image (4 bytes a pixel) plus a generous header: a longer file holds
+// bytes no valid image can use.
+constexpr uint64_t kMaxFileBytes = uint64_t(kMaxPixels) * 4 + (uint64_t{1} << 20);
 
 std::string_view trimmed(std::string_view text) {
   while (!text.empty() && (text.front() == ' ' || text.front() == '\t')) text.remove_prefix(1);
@@ -328,11 +332,14 @@ HdrImage decode_radiance_hdr(std::span<const uint8_t> bytes, const std::string& 
 }
 
 HdrImage read_radiance_hdr(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw AssetError(fmt::format("{}: cannot open: {}", file.string(), errno_text()));
-  std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw AssetError(fmt::format("{}: cannot read: {}", file.string(), errno_text()));
-  return decode_radiance_hdr(bytes, file.string());
+  std::string text;
+  try {
+    text = read_regular_file(file, "Radiance .hdr image", kMaxFileBytes);
+  } catch (const FileAccessError& e) {
+    throw AssetError(e.what());
+  }
+  const auto* bytes = reinterpret_cast<const uint8_t*>(text.data());
+  return decode_radiance_hdr(std::span<const uint8_t>(bytes, text.size()), file.string());
 }
 
 void write_radiance_hdr(const std::filesystem::path& file, const HdrImage& image, bool run_length) {
