@@ -7,7 +7,9 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <limits>
 #include <mutex>
+#include <optional>
 
 #include "capture/recording/recording_reader.h"
 #include "core/log.h"
@@ -16,6 +18,25 @@ namespace arpipe {
 
 namespace {
 constexpr int64_t kFallbackFrameIntervalNs = 33'333'333;  // 30 fps, when a recording says nothing
+
+// The recording source.path names; its problems say which key led to it.
+RecordingReader open_recording(const std::filesystem::path& path) {
+  if (path.empty())
+    throw ConfigError("source.path is empty: a replay needs the recording directory (set source.path, or "
+                      "source.type for a live camera)");
+  try {
+    return RecordingReader(path);
+  } catch (const RecordingError& e) {
+    throw RecordingError(fmt::format("{} (source.path)", e.what()));
+  }
+}
+
+// a + b, or nullopt when int64 nanoseconds cannot hold it.
+std::optional<int64_t> checked_add(int64_t a, int64_t b) {
+  int64_t sum = 0;
+  if (__builtin_add_overflow(a, b, &sum)) return std::nullopt;
+  return sum;
+}
 }
 
 struct ReplaySource::Impl {
@@ -36,7 +57,7 @@ struct ReplaySource::Impl {
   std::condition_variable wake;
   bool interrupted = false;
 
-  explicit Impl(const SourceConfig& c) : config(c), reader(c.path) {}
+  explicit Impl(const SourceConfig& c) : config(c), reader(open_recording(c.path)) {}
   SourceStatus next(Frame& frame);
 };
 
@@ -58,6 +79,16 @@ ReplaySource::ReplaySource(const SourceConfig& config) : impl_(std::make_unique<
     s.model = std::move(model);
   }
   const size_t count = s.reader.frame_count();
+  // Pacing and looping take differences of recorded times: each must fit int64 ns.
+  for (size_t i = 1; i < count; ++i) {
+    int64_t difference = 0;
+    if (__builtin_sub_overflow(s.reader.metadata(i).exposure_start_ns, s.reader.metadata(0).exposure_start_ns,
+                               &difference))
+      throw RecordingError(fmt::format("{}: frame {}'s exposure_start_ns {} lies too far from frame 0's {} for 64-bit "
+                                       "nanoseconds (source.path)",
+                                       config.path.string(), i, s.reader.metadata(i).exposure_start_ns,
+                                       s.reader.metadata(0).exposure_start_ns));
+  }
   if (count > 0) {
     const FrameMetadata& first = s.reader.metadata(0);
     const FrameMetadata& last = s.reader.metadata(count - 1);
@@ -65,8 +96,15 @@ ReplaySource::ReplaySource(const SourceConfig& config) : impl_(std::make_unique<
     if (interval <= 0 && count > 1) interval = (last.exposure_start_ns - first.exposure_start_ns) / int64_t(count - 1);
     if (interval > 0) s.frame_interval_ns = interval;
     if (interval <= 0) interval = kFallbackFrameIntervalNs;
-    s.loop_period_ns = std::max<int64_t>(last.exposure_start_ns - first.exposure_start_ns, 0) + interval;
+    // Too long to loop in int64 ns: the first pass past it ends the replay (next()).
+    s.loop_period_ns = checked_add(std::max<int64_t>(last.exposure_start_ns - first.exposure_start_ns, 0), interval)
+                           .value_or(std::numeric_limits<int64_t>::max());
     s.loop_sequences = last.sequence >= first.sequence ? last.sequence - first.sequence + 1 : count;
+    for (const FrameMetadata* meta : {&first, &last})
+      if (!checked_add(meta->exposure_start_ns, config.timestamp_offset_ns))
+        throw ConfigError(fmt::format("source.timestamp_offset_ns {} added to the exposure start {} ns of {} overflows "
+                                      "64-bit nanoseconds",
+                                      config.timestamp_offset_ns, meta->exposure_start_ns, config.path.string()));
   }
 }
 
@@ -104,17 +142,31 @@ SourceStatus ReplaySource::Impl::next(Frame& frame) {
     ++s.passes;
   }
   const size_t index = s.next_index;
-  const int64_t pass_shift_ns = int64_t(s.passes) * s.loop_period_ns;
+  // Looping adds a period per pass: after enough passes (or with a huge recorded timestamp) the
+  // shifted time no longer fits int64 ns, and the replay ends rather than wrap around.
+  int64_t pass_shift_ns = 0;
+  std::optional<int64_t> shifted, due_ns;
+  if (!__builtin_mul_overflow(int64_t(s.passes), s.loop_period_ns, &pass_shift_ns))
+    if (const auto start = checked_add(s.reader.metadata(index).exposure_start_ns, pass_shift_ns)) {
+      shifted = checked_add(*start, s.config.timestamp_offset_ns);
+      int64_t since_first = 0;  // the constructor checked that this difference fits
+      __builtin_sub_overflow(s.reader.metadata(index).exposure_start_ns, s.reader.metadata(0).exposure_start_ns,
+                             &since_first);
+      due_ns = checked_add(since_first, pass_shift_ns);
+    }
+  if (!shifted || !due_ns) {
+    log::error("replay {}: pass {} of the loop would move frame {}'s timestamp past 64-bit nanoseconds; the replay ends",
+               s.config.path.string(), s.passes + 1, index);
+    return SourceStatus::EndOfStream;
+  }
 
   if (s.paced) {
-    const int64_t due_ns =
-        s.reader.metadata(index).exposure_start_ns - s.reader.metadata(0).exposure_start_ns + pass_shift_ns;
     std::unique_lock lock(s.mutex);
     if (!s.clock_started) {
       s.clock_started = true;
-      s.wall_start = std::chrono::steady_clock::now() - std::chrono::nanoseconds(due_ns);
+      s.wall_start = std::chrono::steady_clock::now() - std::chrono::nanoseconds(*due_ns);
     }
-    const auto due = s.wall_start + std::chrono::nanoseconds(due_ns);
+    const auto due = s.wall_start + std::chrono::nanoseconds(*due_ns);
     s.wake.wait_until(lock, due, [&] { return s.interrupted; });
     if (s.interrupted) {
       s.interrupted = false;
@@ -130,7 +182,7 @@ SourceStatus ReplaySource::Impl::next(Frame& frame) {
     log::warn("replay {}: frame {} skipped: {}", s.config.path.string(), index, e.what());
     return SourceStatus::Retry;
   }
-  frame.meta.exposure_start_ns += pass_shift_ns + s.config.timestamp_offset_ns;
+  frame.meta.exposure_start_ns = *shifted;
   frame.meta.timestamp_offset_ns += s.config.timestamp_offset_ns;
   frame.meta.sequence += s.passes * s.loop_sequences;
   return SourceStatus::Frame;

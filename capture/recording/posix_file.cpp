@@ -10,6 +10,8 @@
 #include <system_error>
 #include <utility>
 
+#include "core/config/regular_file.h"
+
 namespace arpipe {
 
 namespace {
@@ -19,11 +21,15 @@ namespace {
 }  // namespace
 
 PosixFile::PosixFile(const std::filesystem::path& path, Mode mode) : path_(path) {
-  const int flags = mode == Mode::Read ? O_RDONLY : (O_WRONLY | O_CREAT | O_EXCL);
+  if (mode == Mode::Read) {
+    // A recording's parts are regular files: a FIFO would block open() and a device never ends.
+    fd_ = open_regular_file(path, "recording file");
+    return;
+  }
   do {
-    fd_ = ::open(path.c_str(), flags | O_CLOEXEC, 0644);
+    fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
   } while (fd_ < 0 && errno == EINTR);
-  if (fd_ < 0) fail(mode == Mode::Read ? "cannot open" : "cannot create", path);
+  if (fd_ < 0) fail("cannot create", path);
 }
 
 PosixFile::~PosixFile() { close(); }
@@ -69,6 +75,14 @@ bool PosixFile::read_at(uint64_t offset, void* data, size_t size) const {
   return true;
 }
 
+size_t PosixFile::read_some(uint64_t offset, void* data, size_t size) const {
+  for (;;) {
+    const ssize_t n = ::pread(fd_, data, size, off_t(offset));
+    if (n >= 0) return size_t(n);
+    if (errno != EINTR) fail("cannot read", path_);
+  }
+}
+
 uint64_t PosixFile::size() const {
   struct stat st {};
   if (::fstat(fd_, &st) != 0) fail("cannot stat", path_);
@@ -89,7 +103,12 @@ void PosixFile::close() {
 }
 
 void PosixFile::sync_directory(const std::filesystem::path& dir) {
-  PosixFile d(dir, Mode::Read);
+  PosixFile d;
+  d.path_ = dir;
+  do {
+    d.fd_ = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  } while (d.fd_ < 0 && errno == EINTR);
+  if (d.fd_ < 0) fail("cannot open directory", dir);
   // Some file systems refuse fsync on directories (EINVAL); their names are durable anyway.
   if (::fsync(d.fd_) != 0 && errno != EINVAL) fail("cannot fsync directory", dir);
 }

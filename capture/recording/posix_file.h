@@ -11,10 +11,12 @@ namespace arpipe {
 
 class PosixFile {
  public:
-  enum class Mode { Read, CreateNew };  // CreateNew fails when the file exists (O_EXCL)
+  // Read opens regular files only (core/config/regular_file.h: no FIFO, device or /proc);
+  // CreateNew fails when the file exists (O_EXCL).
+  enum class Mode { Read, CreateNew };
 
   PosixFile() = default;
-  // Throws std::system_error whose what() names the path.
+  // Throws std::system_error (FileAccessError for Read) whose what() names the path.
   PosixFile(const std::filesystem::path& path, Mode mode);
   ~PosixFile();
   PosixFile(PosixFile&& other) noexcept;
@@ -28,6 +30,8 @@ class PosixFile {
   void write_at(uint64_t offset, const void* data, size_t size);
   // Reads exactly size bytes at offset; false when the file ends first. Throws on I/O errors.
   bool read_at(uint64_t offset, void* data, size_t size) const;
+  // Reads up to size bytes at offset; returns how many (0 at the end of the file). Throws on I/O errors.
+  size_t read_some(uint64_t offset, void* data, size_t size) const;
   uint64_t size() const;
   void truncate(uint64_t size);
   void sync();

@@ -257,6 +257,14 @@ FrameRecord decode_frame_record(const std::string& line, const std::string& wher
     throw RecordingError(fmt::format("{}: lux and colour_temperature_k must not be negative", where));
   if (m.exposure_ns < 0 || m.readout_ns < 0 || m.frame_duration_ns < 0)
     throw RecordingError(fmt::format("{}: exposure_ns, readout_ns and frame_duration_ns must not be negative", where));
+  // Every later stage adds these (exposure end, next frame's start): the sum must stay in int64 ns.
+  int64_t end_ns = 0;
+  if (__builtin_add_overflow(m.exposure_start_ns, m.exposure_ns, &end_ns) ||
+      __builtin_add_overflow(end_ns, m.readout_ns, &end_ns) ||
+      __builtin_add_overflow(end_ns, m.frame_duration_ns, &end_ns))
+    throw RecordingError(fmt::format("{}: exposure_start_ns {} + exposure_ns {} + readout_ns {} + frame_duration_ns {} "
+                                     "overflows 64-bit nanoseconds",
+                                     where, m.exposure_start_ns, m.exposure_ns, m.readout_ns, m.frame_duration_ns));
   return r;
 }
 

@@ -6,12 +6,14 @@
 #include <zlib.h>
 
 #include <algorithm>
-#include <fstream>
+#include <array>
+#include <cstring>
 #include <optional>
-#include <sstream>
+#include <system_error>
 
 #include "capture/recording/posix_file.h"
 #include "capture/recording/recording_json.h"
+#include "core/config/regular_file.h"
 #include "core/log.h"
 
 namespace arpipe {
@@ -20,28 +22,109 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string read_text(const fs::path& path, const char* what) {
-  if (!fs::exists(path))
-    throw RecordingError(fmt::format("{}: missing (a recording must include its {})", path.string(), what));
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (!in && !in.eof()) throw RecordingError(fmt::format("{}: cannot read", path.string()));
-  return text.str();
+// Limits on what a recording may declare (docs/FORMATS.md): far above what the writer produces,
+// low enough that a few bytes of hostile input cannot make the reader allocate gigabytes.
+constexpr uint64_t kMaxInfoBytes = 1 << 20;               // recording.json: ~400 bytes written
+constexpr size_t kMaxMetadataLineBytes = 64 << 10;        // frames.jsonl: ~400 bytes a line written
+constexpr size_t kMaxGroundTruthLineBytes = 1 << 20;      // ground_truth.jsonl: row poses, ~200 KB at 16384 rows
+constexpr uint64_t kMaxFrameBytes = uint64_t{1} << 30;    // one frame's payload: a 16384 x 16384 RGB24 frame is 805 MB
+
+// "<path>: <reason>" of a std::filesystem query, or nullopt when it succeeded. ENOENT is an answer
+// (no such file), not an error; anything else (a symlink loop, no permission) is reported.
+std::optional<std::string> status_problem(const fs::path& path, fs::file_status& status) {
+  std::error_code ec;
+  status = fs::status(path, ec);
+  if (ec && ec != std::errc::no_such_file_or_directory) return fmt::format("{}: {}", path.string(), ec.message());
+  return std::nullopt;
 }
+
+std::string read_text(const fs::path& path, const char* what, uint64_t max_bytes) {
+  fs::file_status status;
+  if (auto problem = status_problem(path, status)) throw RecordingError(*problem);
+  if (!fs::exists(status))
+    throw RecordingError(fmt::format("{}: missing (a recording must include its {})", path.string(), what));
+  try {
+    return read_regular_file(path, what, max_bytes);
+  } catch (const FileAccessError& e) {
+    throw RecordingError(e.what());
+  }
+}
+
+// Lines of a .jsonl file read one at a time, each at most `max_line` bytes: a line longer than
+// that is refused at the limit, before the whole of it is in memory.
+class JsonlLines {
+ public:
+  JsonlLines(const fs::path& path, const char* what, size_t max_line) : path_(path), max_line_(max_line) {
+    fs::file_status status;
+    if (auto problem = status_problem(path, status)) throw RecordingError(*problem);
+    if (!fs::exists(status))
+      throw RecordingError(fmt::format("{}: missing (a recording must include its {})", path.string(), what));
+    try {
+      file_ = PosixFile(path, PosixFile::Mode::Read);
+    } catch (const std::exception& e) {
+      throw RecordingError(e.what());
+    }
+  }
+
+  // The next line without its newline; `complete` is false for a last line without one. False at
+  // the end of the file.
+  bool next(std::string& line, bool& complete) {
+    line.clear();
+    ++line_number_;
+    for (;;) {
+      if (pos_ == end_ && !fill()) {
+        complete = false;
+        return !line.empty();
+      }
+      const char* begin = buffer_.data() + pos_;
+      const char* newline = static_cast<const char*>(std::memchr(begin, '\n', end_ - pos_));
+      const size_t take = newline != nullptr ? size_t(newline - begin) : end_ - pos_;
+      if (line.size() + take > max_line_)
+        throw RecordingError(fmt::format("{} line {}: longer than the limit of {} bytes for one line", path_.string(),
+                                         line_number_, max_line_));
+      line.append(begin, take);
+      pos_ += take;
+      if (newline != nullptr) {
+        ++pos_;
+        complete = true;
+        return true;
+      }
+    }
+  }
+  size_t line_number() const { return line_number_; }
+
+ private:
+  bool fill() {
+    try {
+      end_ = file_.read_some(offset_, buffer_.data(), buffer_.size());
+    } catch (const std::system_error& e) {
+      throw RecordingError(fmt::format("{} line {}: {}", path_.string(), line_number_, e.what()));
+    }
+    offset_ += end_;
+    pos_ = 0;
+    return end_ > 0;
+  }
+
+  fs::path path_;
+  size_t max_line_;
+  PosixFile file_;
+  std::array<char, 65536> buffer_{};
+  uint64_t offset_ = 0;
+  size_t pos_ = 0, end_ = 0;
+  size_t line_number_ = 0;
+};
 
 // The records of a .jsonl file. A last line without its newline was cut off mid-append: it is
 // kept if it still parses (only the newline was lost) and dropped with a warning otherwise.
 template <typename Record, typename Decode>
-std::vector<Record> parse_jsonl(const std::string& text, const fs::path& path, Decode decode,
+std::vector<Record> parse_jsonl(JsonlLines lines, const fs::path& path, Decode decode,
                                 std::vector<std::string>& warnings) {
   std::vector<Record> records;
-  size_t begin = 0;
-  for (size_t line_number = 1; begin < text.size(); ++line_number) {
-    const size_t end = text.find('\n', begin);
-    const std::string where = fmt::format("{} line {}", path.string(), line_number);
-    if (end == std::string::npos) {
-      const std::string line = text.substr(begin);
+  std::string line;
+  bool complete = false;
+  while (lines.next(line, complete)) {
+    const std::string where = fmt::format("{} line {}", path.string(), lines.line_number());
+    if (!complete) {
       try {
         records.push_back(decode(line, where));
         warnings.push_back(
@@ -52,8 +135,7 @@ std::vector<Record> parse_jsonl(const std::string& text, const fs::path& path, D
       }
       break;
     }
-    records.push_back(decode(text.substr(begin, end - begin), where));
-    begin = end + 1;
+    records.push_back(decode(line, where));
   }
   return records;
 }
@@ -73,15 +155,29 @@ struct RecordingReader::Impl {
 
   void load_info() {
     const fs::path path = dir / kRecordingInfoFile;
-    if (!fs::exists(path))
+    fs::file_status status;
+    if (auto problem = status_problem(path, status)) throw RecordingError(*problem);
+    if (!fs::exists(status))
       throw RecordingError(fmt::format("{}: missing (not an arpipe recording directory?)", path.string()));
-    recording_json::decode_info(read_text(path, "description"), path.string(), info, files);
+    recording_json::decode_info(read_text(path, "description", kMaxInfoBytes), path.string(), info, files);
+    // Checked: width, height and bytes_per_line are bounded by decode_info, but the product is what
+    // every frame read allocates.
+    uint64_t rows_bytes = 0;
+    const uint64_t rows = info.pixel_format == PixelFormat::NV12 ? uint64_t(info.height) + uint64_t(info.height / 2)
+                                                                 : uint64_t(info.height);
+    if (__builtin_mul_overflow(uint64_t(info.bytes_per_line), rows, &rows_bytes) || rows_bytes > kMaxFrameBytes)
+      throw RecordingError(fmt::format("{}: a {}x{} {} frame with {} bytes per line exceeds the limit of {} bytes per "
+                                       "frame",
+                                       path.string(), info.width, info.height, pixel_format_name(info.pixel_format),
+                                       info.bytes_per_line, kMaxFrameBytes));
     frame_bytes = image_bytes(info.pixel_format, info.width, info.height, info.bytes_per_line);
   }
 
   void load_camera_model() {
     const fs::path path = dir / files.camera_model;
-    if (!fs::exists(path))
+    fs::file_status status;
+    if (auto problem = status_problem(path, status)) throw RecordingError(*problem);
+    if (!fs::exists(status))
       throw RecordingError(fmt::format("{}: missing (a recording must include its camera model)", path.string()));
     try {
       model = CameraModel::load(path);
@@ -97,16 +193,18 @@ struct RecordingReader::Impl {
   void load_frame_records() {
     const fs::path metadata_path = dir / files.metadata;
     const fs::path frames_path = dir / files.frames;
-    const std::string text = read_text(metadata_path, "frame metadata");
-    if (!fs::exists(frames_path))
+    JsonlLines lines(metadata_path, "frame metadata", kMaxMetadataLineBytes);
+    fs::file_status status;
+    if (auto problem = status_problem(frames_path, status)) throw RecordingError(*problem);
+    if (!fs::exists(status))
       throw RecordingError(fmt::format("{}: missing (a recording must include its frames)", frames_path.string()));
     try {
       frames = PosixFile(frames_path, PosixFile::Mode::Read);
     } catch (const std::exception& e) {
       throw RecordingError(e.what());
     }
-    records =
-        parse_jsonl<recording_json::FrameRecord>(text, metadata_path, recording_json::decode_frame_record, warnings);
+    records = parse_jsonl<recording_json::FrameRecord>(std::move(lines), metadata_path,
+                                                       recording_json::decode_frame_record, warnings);
     uint64_t expected_offset = 0;
     for (size_t i = 0; i < records.size(); ++i) {
       const auto& r = records[i];
@@ -143,9 +241,12 @@ struct RecordingReader::Impl {
 
   void load_ground_truth() {
     const fs::path path = dir / files.ground_truth;
-    if (!fs::exists(path)) return;
-    const auto truths = parse_jsonl<recording_json::GroundTruthRecord>(read_text(path, "ground truth"), path,
-                                                                       recording_json::decode_ground_truth, warnings);
+    fs::file_status status;
+    if (auto problem = status_problem(path, status)) throw RecordingError(*problem);
+    if (!fs::exists(status)) return;
+    const auto truths =
+        parse_jsonl<recording_json::GroundTruthRecord>(JsonlLines(path, "ground truth", kMaxGroundTruthLineBytes), path,
+                                                       recording_json::decode_ground_truth, warnings);
     for (size_t i = 0; i < truths.size(); ++i) {
       const std::string where = fmt::format("{} line {}", path.string(), i + 1);
       if (truths[i].index != i)
@@ -174,8 +275,12 @@ struct RecordingReader::Impl {
 RecordingReader::RecordingReader(const fs::path& dir) : impl_(std::make_unique<Impl>()) {
   Impl& r = *impl_;
   r.dir = dir;
-  if (!fs::is_directory(dir))
-    throw RecordingError(fmt::format("{}: not a recording (no such directory)", dir.string()));
+  if (dir.empty()) throw RecordingError("not a recording: the directory's path is empty");
+  fs::file_status status;
+  if (auto problem = status_problem(dir, status)) throw RecordingError(*problem + " (the recording directory)");
+  if (!fs::is_directory(status))
+    throw RecordingError(fmt::format("{}: not a recording ({})", dir.string(),
+                                     fs::exists(status) ? "not a directory" : "no such directory"));
   r.load_info();
   r.load_camera_model();
   r.load_frame_records();
