@@ -4,6 +4,8 @@
 #include <charconv>
 #include <cstdio>
 #include <exception>
+#include <new>
+#include <stdexcept>
 
 #include "apps/arpipe/commands.h"
 #include "apps/arpipe/progress_bar.h"
@@ -68,6 +70,12 @@ int run_simulate(const Args& args) {
   sim::SimScene scene;
   try {
     scene = sim::load_sim_scene(scene_path);
+  } catch (const std::bad_alloc&) {  // the loaders cap what they allocate; this names the file if one did not
+    log::error("{}: out of memory while loading the scene and its assets", scene_path);
+    return 2;
+  } catch (const std::length_error& e) {
+    log::error("{}: a size in the scene or its assets is too large ({})", scene_path, e.what());
+    return 2;
   } catch (const std::exception& e) {
     log::error("{}", e.what());
     return 2;
@@ -83,6 +91,10 @@ int run_simulate(const Args& args) {
               (summary.seconds - summary.setup_seconds) / summary.frames,
               summary.wrote_composite ? ", with the ground-truth composite" : "");
     return 0;
+  } catch (const std::bad_alloc&) {
+    progress.finish();
+    log::error("{}: out of memory while simulating into {}", scene_path, options.out_dir.string());
+    return 1;
   } catch (const std::exception& e) {
     progress.finish();
     log::error("{}", e.what());

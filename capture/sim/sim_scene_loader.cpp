@@ -18,10 +18,17 @@
 #include <opencv2/imgcodecs.hpp>
 #include <set>
 #include <sstream>
+#include <system_error>
 
+#include <unistd.h>
+
+#include "capture/sim/sim_textures.h"
+#include "capture/sim/simulator.h"
+#include "core/config/regular_file.h"
 #include "core/config/toml_stray_key.h"
 #include "core/config/text_file.h"
 #include "core/config/toml_type_phrase.h"
+#include "core/image/image_header.h"
 #include "core/scene/asset_error.h"
 #include "core/scene/builtin_meshes.h"
 #include "core/scene/gltf_loader.h"
@@ -35,6 +42,12 @@ namespace fs = std::filesystem;
 
 constexpr double kRadiansPerDegree = std::numbers::pi / 180.0;
 constexpr double kNsPerMs = 1e6;
+// Counts a scene file may declare: far above any real scene, low enough that a small file cannot
+// make the simulator build thousands of Embree objects or walk millions of keyframes.
+constexpr size_t kMaxObjects = 1000;
+constexpr size_t kMaxLights = 100;
+constexpr size_t kMaxKeyframes = 100000;
+constexpr size_t kMaxListNumbers = 10000;  // exposure cycles, intrinsics (a splined model has a few thousand)
 // `up` closer than this (sine of the angle) to the viewing direction leaves the image's roll
 // undefined for practical purposes (0.06 degrees).
 constexpr double kMinUpAngleSine = 1e-3;
@@ -127,13 +140,16 @@ class Section {
     return Section(r_, *n->as_table(), key(k), base_dir_);
   }
   // [[k]] entries (or an inline array of inline tables), named "k[0]", "k[1]"...
-  std::vector<Section> tables(std::string_view k) const {
+  // At most max_count of them (the limit is in the message).
+  std::vector<Section> tables(std::string_view k, size_t max_count) const {
     std::vector<Section> out;
     const toml::node* n = node(k);
     if (n == nullptr) return out;
     const std::string expected = fmt::format("an array of tables ([[{}]])", k);
     if (!n->is_array()) fail(k, expected, type_phrase(*n));
     const toml::array& array = *n->as_array();
+    if (array.size() > max_count)
+      fail(k, fmt::format("at most {} [[{}]] tables", max_count, k), fmt::format("{}", array.size()));
     for (size_t i = 0; i < array.size(); ++i) {
       const std::string item = fmt::format("{}[{}]", key(k), i);
       if (!array[i].is_table()) fail(array[i], item, "a table", type_phrase(array[i]));
@@ -198,13 +214,16 @@ class Section {
     return value;
   }
 
-  std::vector<double> numbers(std::string_view k, std::vector<double> fallback, const Range& range = kAnyNumber) const {
+  std::vector<double> numbers(std::string_view k, std::vector<double> fallback, const Range& range = kAnyNumber,
+                              size_t max_count = kMaxListNumbers) const {
     const toml::node* n = node(k);
     if (n == nullptr) return fallback;
     const std::string expected = fmt::format("an array of numbers ({} each)", range.phrase);
     if (!n->is_array()) fail(k, expected, type_phrase(*n));
     std::vector<double> out;
     const toml::array& array = *n->as_array();
+    if (array.size() > max_count)
+      fail(k, fmt::format("an array of at most {} numbers", max_count), fmt::format("{} numbers", array.size()));
     for (size_t i = 0; i < array.size(); ++i)
       out.push_back(number_of(array[i], fmt::format("{}[{}]", key(k), i), range));
     return out;
@@ -230,14 +249,25 @@ class Section {
     if (path.is_relative() && !base_dir_.empty()) path = base_dir_ / path;
     path = path.lexically_normal();
     std::error_code ec;
-    if (!fs::exists(path, ec))
+    const fs::file_status status = fs::status(path, ec);
+    if (ec && ec != std::errc::no_such_file_or_directory)  // a symlink loop, no permission on a directory
+      fail(k, fmt::format("expected {}, found \"{}\" ({}): {}", what, text, path.string(), ec.message()));
+    if (!fs::exists(status))
       fail(k, fmt::format("expected {}, found \"{}\" ({}): no such file", what, text, path.string()));
-    if (fs::is_directory(path, ec))
+    if (fs::is_directory(status))
       fail(k, fmt::format("expected {}, found \"{}\" ({}): a directory", what, text, path.string()));
-    std::ifstream in(path, std::ios::binary);
-    if (!in || in.peek() == std::ifstream::traits_type::eof())
-      fail(k, fmt::format("expected {}, found \"{}\" ({}): cannot read it: {}", what, text, path.string(),
-                          in ? "it is empty" : std::strerror(errno)));
+    // Regular files only (no FIFO to block on, no device), and not empty.
+    try {
+      const int fd = open_regular_file(path, what);
+      char first = 0;
+      const ssize_t n = ::read(fd, &first, 1);
+      ::close(fd);
+      if (n != 1)
+        fail(k, fmt::format("expected {}, found \"{}\" ({}): cannot read it: {}", what, text, path.string(),
+                            n == 0 ? "it is empty" : std::strerror(errno)));
+    } catch (const FileAccessError& e) {
+      fail(k, fmt::format("expected {}, found \"{}\" ({}): {}", what, text, path.string(), e.reason()));
+    }
     return path;
   }
 
@@ -336,6 +366,13 @@ SimCamera read_camera(const Section& s) {
     const std::string_view k = s.has("pixel_format") ? "pixel_format" : s.has("model") ? "model" : "width";
     s.fail(k, fmt::format("expected an image size that {} can hold, found {}x{}: {}", format, camera.model.width(),
                           camera.model.height(), *problem));
+  }
+  if (camera.model.width() > kMaxFrameSide || camera.model.height() > kMaxFrameSide ||
+      int64_t{camera.model.width()} * camera.model.height() > kMaxFramePixels) {
+    const std::string_view k = s.has("model") ? "model" : camera.model.width() > kMaxFrameSide || !s.has("height") ? "width" : "height";
+    s.fail(k, fmt::format("expected a simulated frame of at most {} pixels a side and {} pixels in all (rendering "
+                          "holds about 80 bytes a pixel), found {}x{}",
+                          kMaxFrameSide, kMaxFramePixels, camera.model.width(), camera.model.height()));
   }
 
   camera.fps =
@@ -489,7 +526,7 @@ SimTrajectory read_trajectory(const std::optional<Section>& s) {
     return trajectory;
   }
   s->forbid("random", "[trajectory.random] needs kind = \"random\"");
-  for (const Section& k : s->tables("keyframe"))
+  for (const Section& k : s->tables("keyframe", kMaxKeyframes))
     trajectory.keyframes.push_back(
         read_keyframe(k, trajectory.keyframes.empty() ? nullptr : &trajectory.keyframes.back()));
   if (trajectory.keyframes.empty())
@@ -520,6 +557,19 @@ void read_texture(const Section& object, const Section& s, SimObject& out) {
     t.kind = SimTexture::Kind::Image;
     if (!object.has("albedo")) out.material.albedo = {1, 1, 1};  // the image's own colours unless scaled
     t.image_path = s.file("image", "an image file (PNG or JPEG)");
+    // The header's size is checked before anything decodes the image (sim_textures.cpp again).
+    ImageHeader header;
+    try {
+      header = read_image_header(t.image_path);
+    } catch (const AssetError& e) {
+      s.fail("image", fmt::format("expected an image file (PNG or JPEG), found one that is not: {}", e.what()));
+    }
+    if (header.width > kMaxTextureSide || header.height > kMaxTextureSide ||
+        header.width * header.height > kMaxTexturePixels)
+      s.fail("image", fmt::format("expected an image of at most {} pixels a side and {} pixels in all, found \"{}\": "
+                                  "{} x {} {}",
+                                  kMaxTextureSide, kMaxTexturePixels, t.image_path.string(), header.width,
+                                  header.height, header.format));
     if (!cv::haveImageReader(t.image_path.string()))
       s.fail("image",
              fmt::format("expected an image file OpenCV can decode (PNG or JPEG), found \"{}\", which is not one",
@@ -719,11 +769,11 @@ SimScene read_scene(const Reader& reader, const toml::table& root, const fs::pat
   if (const auto render = top.table("render")) scene.render = read_render(*render);
   scene.trajectory = read_trajectory(top.table("trajectory"));
 
-  const std::vector<Section> objects = top.tables("object");
+  const std::vector<Section> objects = top.tables("object", kMaxObjects);
   for (size_t i = 0; i < objects.size(); ++i) scene.objects.push_back(read_object(objects[i], i));
   check_unique_names(objects, scene.objects, "object");
 
-  const std::vector<Section> lights = top.tables("light");
+  const std::vector<Section> lights = top.tables("light", kMaxLights);
   for (size_t i = 0; i < lights.size(); ++i) scene.lights.push_back(read_light(lights[i], i));
   check_unique_names(lights, scene.lights, "light");
   if (const auto sun = top.table("sun")) {

@@ -11,6 +11,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 
+#include "core/image/hdr_file.h"
+#include "core/image/image_header.h"
 #include "core/scene/asset_error.h"
 #include "core/track/tag_family.h"
 
@@ -33,6 +35,20 @@ cv::Mat read_image(const fs::path& path, int flags, const std::string& what) {
 }
 
 int clamp_index(double x, int n) { return std::clamp(int(x), 0, n - 1); }
+
+// The size the file declares, checked before OpenCV decodes it: a few KB of PNG can declare
+// 30000 x 30000 pixels (13 GB once decoded and turned into floats).
+void check_texture_header(const fs::path& path, const std::string& what) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw AssetError(fmt::format("{} \"{}\": no such file", what, path.string()));
+  ImageHeader header;
+  try {
+    header = read_image_header(path);
+  } catch (const AssetError& e) {
+    throw AssetError(fmt::format("{}: {}", what, e.what()));
+  }
+  check_image_limits(header, path, what, kMaxTextureSide, kMaxTexturePixels);
+}
 
 }  // namespace
 
@@ -74,8 +90,9 @@ PlaneTexture::PlaneTexture(const SimMaterial& material, const std::string& objec
       margin_ = texture.margin_squares;
       break;
     case SimTexture::Kind::Image: {
-      const cv::Mat image =
-          read_image(texture.image_path, cv::IMREAD_COLOR, fmt::format("object \"{}\": image texture", object_name));
+      const std::string what = fmt::format("object \"{}\": image texture", object_name);
+      check_texture_header(texture.image_path, what);
+      const cv::Mat image = read_image(texture.image_path, cv::IMREAD_COLOR, what);
       if (image.depth() != CV_8U)
         throw AssetError(fmt::format("object \"{}\": image texture \"{}\": expected 8-bit sRGB", object_name,
                                      texture.image_path.string()));
@@ -143,27 +160,21 @@ EnvironmentMap::EnvironmentMap(const SimEnvironment& environment)
     black_ = constant_[0] == 0 && constant_[1] == 0 && constant_[2] == 0;
     return;
   }
-  const std::string what = "HDR environment";
-  const cv::Mat image = read_image(environment.hdr_path, cv::IMREAD_ANYDEPTH | cv::IMREAD_COLOR, what);
-  if (image.depth() != CV_32F || image.channels() != 3)
-    throw AssetError(fmt::format("{} \"{}\": expected a floating-point RGB image (.hdr), got OpenCV type {}", what,
-                                 environment.hdr_path.string(), image.type()));
-  width_ = image.cols;
-  height_ = image.rows;
-  rgb_.resize(size_t(width_) * height_ * 3);
+  // The project's own HDR reader: its header limits (core/image/radiance_hdr.h) come before any
+  // allocation, where OpenCV's decoder asserted on a huge declared size; it also checks every texel.
+  HdrImage image;
+  try {
+    image = read_hdr_image(environment.hdr_path);
+  } catch (const AssetError& e) {
+    throw AssetError(fmt::format("HDR environment: {}", e.what()));
+  }
+  width_ = image.width;
+  height_ = image.height;
+  rgb_ = std::move(image.rgb);
   black_ = true;
-  for (int row = 0; row < height_; ++row) {
-    const float* bgr = image.ptr<float>(row);
-    for (int col = 0; col < width_; ++col)
-      for (int c = 0; c < 3; ++c) {
-        const float value = bgr[col * 3 + 2 - c];
-        if (!std::isfinite(value) || value < 0)
-          throw AssetError(fmt::format("{} \"{}\": pixel (x {}, y {}) holds {}, expected a finite radiance >= 0", what,
-                                       environment.hdr_path.string(), col, row, value));
-        const float scaled = float(value * constant_[size_t(c)]);
-        rgb_[(size_t(row) * width_ + col) * 3 + c] = scaled;
-        if (scaled != 0) black_ = false;
-      }
+  for (size_t i = 0; i < rgb_.size(); ++i) {
+    rgb_[i] = float(rgb_[i] * constant_[i % 3]);
+    if (rgb_[i] != 0) black_ = false;
   }
 }
 

@@ -11,12 +11,18 @@
 
 namespace arpipe::sim {
 
+// Image textures: at most 16384 pixels a side and 2^25 pixels (an 8192 x 4096 photo) in all, 400 MB
+// as floats; checked on the file's header before it is decoded.
+inline constexpr int64_t kMaxTextureSide = 16384;
+inline constexpr int64_t kMaxTexturePixels = int64_t{1} << 25;
+
 // Linear reflectance over a plane's texture coordinates (u left to right, v top to bottom, both
 // in [0, 1], as sim_scene.h defines them). Two-tone textures are sampled nearest-texel (crisp
 // edges: the camera's area sampling anti-aliases them); image files bilinearly.
 class PlaneTexture {
  public:
-  // Throws AssetError naming the file for an unreadable image, std::invalid_argument naming
+  // Throws AssetError naming the file for an unreadable image or one over the size limits above
+  // (with the limit), std::invalid_argument naming
   // `object_name` for an unknown tag family, a tag id outside it or a board without squares.
   PlaneTexture(const SimMaterial& material, const std::string& object_name);
 

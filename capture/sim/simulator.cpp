@@ -145,6 +145,10 @@ SimulateSummary simulate(const SimScene& scene, const SimulateOptions& options) 
   if (frames <= 0) throw std::invalid_argument(fmt::format("simulate: frames must be positive, got {}", frames));
   const uint64_t seed = options.seed.value_or(scene.render.seed);
   const int width = camera.model.width(), height = camera.model.height();
+  if (width > kMaxFrameSide || height > kMaxFrameSide || int64_t{width} * height > kMaxFramePixels)
+    throw std::invalid_argument(fmt::format("simulate: a {}x{} frame exceeds the limit of {} pixels a side and {} "
+                                            "pixels in all (rendering holds about 80 bytes a pixel)",
+                                            width, height, kMaxFrameSide, kMaxFramePixels));
 
   int64_t longest_exposure_ns = 0;
   for (int64_t e : camera.exposure_ns) longest_exposure_ns = std::max(longest_exposure_ns, e);

@@ -12,6 +12,11 @@
 
 namespace arpipe::sim {
 
+// The largest simulated frame: rendering holds about 80 bytes a pixel (radiance, linear image,
+// exposed frames), so 2^24 pixels (4096 x 4096, or 5472 x 3072) is about 1.3 GB.
+inline constexpr int64_t kMaxFrameSide = 8192;
+inline constexpr int64_t kMaxFramePixels = int64_t{1} << 24;
+
 // The ground-truth composite's recording, inside the output directory.
 inline constexpr const char* kGroundTruthCompositeDir = "ground_truth_composite";
 // The scene file as simulated, copied into the output directory.
@@ -34,7 +39,8 @@ struct SimulateSummary {
   bool wrote_composite = false;
 };
 
-// Throws AssetError (a scene asset), RecordingError (writing), std::invalid_argument (options).
+// Throws AssetError (a scene asset), RecordingError (writing), std::invalid_argument (options, or a
+// frame over kMaxFrameSide / kMaxFramePixels).
 // Frames written before an error stay readable.
 SimulateSummary simulate(const SimScene& scene, const SimulateOptions& options);
 
