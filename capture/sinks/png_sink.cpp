@@ -2,19 +2,24 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cstring>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <algorithm>
 #include <stdexcept>
+#include <vector>
 
 #include "capture/sinks/output_path.h"
-#include "core/log.h"
 
 namespace arpipe {
 
-PngSink::PngSink(const PngSinkConfig& config) : dir_(config.dir), every_(std::max(1, config.every)) {
+PngSink::PngSink(const PngSinkConfig& config)
+    : dir_(config.dir), every_(std::max(1, config.every)), outage_(dir_.string(), "no partial PNG is left behind") {
   create_output_directory(dir_, "sinks.png.dir");
+  remove_stale_temporaries(dir_, [](std::string_view target) { return target.starts_with("frame_"); });
 }
+
+PngSink::~PngSink() { outage_.report_at_end(); }
 
 std::string PngSink::describe() const { return "png:" + dir_.string(); }
 
@@ -24,16 +29,24 @@ std::filesystem::path PngSink::file_name(const std::filesystem::path& dir, uint6
 
 void PngSink::consume(const FrameContext& ctx) noexcept {
   if (ctx.output.empty() || ctx.input_index % uint64_t(every_) != 0) return;
-  const auto path = file_name(dir_, ctx.input_index);
+  std::string why;
   try {
+    const auto path = file_name(dir_, ctx.input_index);
     const cv::Mat rgb(ctx.output.height, ctx.output.width, CV_8UC3, const_cast<uint8_t*>(ctx.output.data.data()),
                       ctx.output.bytes_per_line);
     cv::Mat bgr;
     cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
-    if (!cv::imwrite(path.string(), bgr)) throw std::runtime_error("the PNG encoder refused the file");
+    // Encoded in memory: libpng never meets a failing file (and prints nothing), and the file is
+    // written whole or not at all.
+    std::vector<uint8_t> png;
+    if (!cv::imencode(".png", bgr, png)) throw std::runtime_error("the PNG encoder refused the frame");
+    if (const int error = replace_file(path, png))
+      why = fmt::format("{}: {}", path.string(), std::strerror(error));
   } catch (const std::exception& e) {
-    if (failures_++ == 0) log::error("{}: cannot write: {} (further failures are only counted)", path.string(), e.what());
+    why = e.what();
   }
+  if (why.empty()) outage_.succeeded(ctx.input_index);
+  else outage_.failed(ctx.input_index, why);
 }
 
 }  // namespace arpipe

@@ -7,12 +7,24 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
-#include "capture/sinks/output_path.h"
 #include "core/log.h"
 
 namespace arpipe {
 
-ResultsSink::ResultsSink(const ResultsSinkConfig& config) : path_(config.path), file_(path_, "sinks.results.path") {}
+ResultsSink::ResultsSink(const ResultsSinkConfig& config)
+    : path_(config.path),
+      file_(path_, "sinks.results.path"),
+      outage_(path_.string(), "the file ends at its last complete line") {}
+
+// Never committed (the start failed): OutputFile removes this run's file and the previous one stays.
+ResultsSink::~ResultsSink() { outage_.report_at_end(); }
+
+void ResultsSink::run_started() noexcept {
+  std::string error;
+  if (!file_.committed() && !file_.commit(error))
+    log::error("{}: cannot replace it with this run's results: {}; they are in {}", path_.string(), error,
+               file_.temporary().string());
+}
 
 std::string ResultsSink::describe() const { return "results:" + path_.string(); }
 
@@ -88,16 +100,26 @@ std::string ResultsSink::to_json_line(const FrameContext& ctx) {
 }
 
 void ResultsSink::consume(const FrameContext& ctx) noexcept {
+  run_started();
+  std::string line;
   try {
-    const std::string line = to_json_line(ctx) + "\n";
-    // One line per frame, flushed, so a crash loses at most the frame being written.
-    if (std::fwrite(line.data(), 1, line.size(), file_.get()) != line.size() || std::fflush(file_.get()) != 0)
-      throw std::runtime_error(std::strerror(errno));
+    line = to_json_line(ctx) + "\n";
   } catch (const std::exception& e) {
-    if (failures_++ == 0) log::error("{}: cannot write frame {}: {}", path_.string(), ctx.input_index, e.what());
+    if (encode_failures_++ == 0)
+      log::error("{}: cannot encode frame {}: {} (further failures are only counted)", path_.string(), ctx.input_index,
+                 e.what());
+    return;
   }
+  // One write per line: a crash loses at most the line being written, and a failed write is cut back
+  // to the previous line's end, so the file never holds a partial or merged line.
+  const int error = file_.append({std::span(reinterpret_cast<const uint8_t*>(line.data()), line.size())});
+  if (error) outage_.failed(ctx.input_index, std::strerror(error));
+  else outage_.succeeded(ctx.input_index);
 }
 
-void ResultsSink::flush() noexcept { file_.sync(); }
+void ResultsSink::flush() noexcept {
+  run_started();
+  file_.sync();
+}
 
 }  // namespace arpipe
