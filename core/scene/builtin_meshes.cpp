@@ -141,11 +141,13 @@ Mesh make_plane_mesh(double edge_m, int subdivisions) {
 bool is_builtin_mesh_source(std::string_view source) { return source.substr(0, kBuiltinMeshPrefix.size()) == kBuiltinMeshPrefix; }
 
 std::optional<Mesh> make_builtin_mesh(std::string_view source) {
-  if (source == "builtin:cube") return make_cube_mesh();
-  if (source == "builtin:pyramid") return make_pyramid_mesh();
-  if (source == "builtin:sphere") return make_sphere_mesh();
-  if (source == "builtin:cup") return make_cup_mesh();
-  return std::nullopt;
+  std::optional<Mesh> mesh;
+  if (source == "builtin:cube") mesh = make_cube_mesh();
+  if (source == "builtin:pyramid") mesh = make_pyramid_mesh();
+  if (source == "builtin:sphere") mesh = make_sphere_mesh();
+  if (source == "builtin:cup") mesh = make_cup_mesh();
+  if (mesh) mesh->source = std::string(source);  // messages about the mesh (a PRT bake's) name it
+  return mesh;
 }
 
 }  // namespace arpipe

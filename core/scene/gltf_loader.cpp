@@ -14,18 +14,22 @@
 #include <fmt/format.h>
 
 #include <array>
-#include <cerrno>
+#include <cmath>
 #include <cstring>
-#include <fstream>
 #include <glm/glm.hpp>
 #include <glm/gtc/matrix_inverse.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
-#include <set>
+#include <limits>
+#include <new>
+#include <tuple>
 
 #include "core/log.h"
 #include "core/scene/asset_error.h"
+#include "core/scene/asset_file.h"
+#include "core/scene/gltf_document.h"
+#include "core/scene/gltf_limits.h"
 
 namespace arpipe {
 namespace {
@@ -35,68 +39,237 @@ bool ignore_image(tinygltf::Image*, const int, std::string*, std::string*, int, 
   return true;
 }
 
-std::string trimmed(std::string text) {
-  while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
-  return text;
+// tinygltf's messages, trimmed, each line cut short (a failed data URI is quoted whole).
+std::string tinygltf_message(const std::string& text) {
+  std::string out, line;
+  auto flush = [&] {
+    while (!line.empty() && line.back() == ' ') line.pop_back();
+    if (line.empty()) return;
+    if (line.size() > 200) line = line.substr(0, 200) + "...";
+    out += (out.empty() ? "" : "; ") + line;
+    line.clear();
+  };
+  for (char c : text) {
+    if (c == '\n') flush();
+    else line += c;
+  }
+  flush();
+  return out.empty() ? "unknown error" : out;
 }
 
-glm::dmat4 node_transform(const tinygltf::Node& node) {
-  if (node.matrix.size() == 16) return glm::make_mat4(node.matrix.data());  // column-major, as glTF stores it
-  glm::dmat4 transform(1.0);
-  if (node.translation.size() == 3)
-    transform = glm::translate(transform, glm::dvec3(node.translation[0], node.translation[1], node.translation[2]));
-  if (node.rotation.size() == 4)  // glTF quaternions are x, y, z, w; glm's constructor takes w first
-    transform *= glm::mat4_cast(glm::dquat(node.rotation[3], node.rotation[0], node.rotation[1], node.rotation[2]));
-  if (node.scale.size() == 3) transform = glm::scale(transform, glm::dvec3(node.scale[0], node.scale[1], node.scale[2]));
-  return transform;
+// tinygltf's file system for external buffers: every path is checked again here (the document's
+// checks may be stale by the time tinygltf reads), within the buffer byte budget.
+struct ExternalFiles {
+  std::filesystem::path folder;
+  uint64_t bytes_left = kMaxGltfBufferBytes;
+};
+
+bool external_file_exists(const std::string&, void*) { return true; }  // read_external_file says what is wrong
+std::string keep_file_path(const std::string& path, void*) { return path; }  // no "~" or "$VAR" expansion
+bool refuse_write(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+  if (err) *err = "writing is not allowed";
+  return false;
+}
+
+bool read_external_file(std::vector<unsigned char>* out, std::string* err, const std::string& joined_path,
+                        void* user_data) {
+  ExternalFiles& files = *static_cast<ExternalFiles*>(user_data);
+  // tinygltf joins the folder, "/" and the decoded URI; resolve what follows the folder.
+  const std::string prefix = files.folder.string() + "/";
+  std::string why;
+  if (joined_path.compare(0, prefix.size(), prefix) != 0) {
+    if (err) *err = "not inside the glTF file's folder";
+    return false;
+  }
+  const std::optional<std::filesystem::path> file =
+      resolve_inside_folder(files.folder, joined_path.substr(prefix.size()), &why);
+  std::optional<std::vector<unsigned char>> bytes;
+  if (file) bytes = read_regular_file(*file, files.bytes_left, &why);
+  if (!bytes) {
+    if (err) *err = why;
+    return false;
+  }
+  files.bytes_left -= bytes->size();
+  *out = std::move(*bytes);
+  return true;
+}
+
+bool all_finite(const std::vector<double>& values) {
+  for (double v : values)
+    if (!std::isfinite(v)) return false;
+  return true;
+}
+
+bool all_finite(const glm::dmat4& m) {
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r)
+      if (!std::isfinite(m[c][r])) return false;
+  return true;
+}
+
+bool all_finite(const glm::dmat3& m) {
+  for (int c = 0; c < 3; ++c)
+    for (int r = 0; r < 3; ++r)
+      if (!std::isfinite(m[c][r])) return false;
+  return true;
 }
 
 class GltfMeshCollector {
  public:
-  GltfMeshCollector(const tinygltf::Model& model, const std::filesystem::path& path) : model_(model), path_(path) {}
+  GltfMeshCollector(const tinygltf::Model& model, const std::filesystem::path& path)
+      : model_(model), path_(path), reached_(model.nodes.size(), false) {}
 
-  void add_node(int node_index, const glm::dmat4& parent, std::set<int>& ancestors) {
-    if (node_index < 0 || static_cast<size_t>(node_index) >= model_.nodes.size())
-      fail(fmt::format("node {} does not exist ({} nodes)", node_index, model_.nodes.size()));
-    if (!ancestors.insert(node_index).second) fail(fmt::format("node {} is its own ancestor", node_index));
-    const tinygltf::Node& node = model_.nodes[static_cast<size_t>(node_index)];
-    const glm::dmat4 transform = parent * node_transform(node);
-    if (node.mesh >= 0) {
-      if (static_cast<size_t>(node.mesh) >= model_.meshes.size())
-        fail(fmt::format("node {} names mesh {}, which does not exist", node_index, node.mesh));
-      const tinygltf::Mesh& mesh = model_.meshes[static_cast<size_t>(node.mesh)];
-      for (size_t p = 0; p < mesh.primitives.size(); ++p) add_primitive(node.mesh, p, mesh.primitives[p], transform);
+  // The node hierarchy under `roots`, walked depth-first with an explicit stack (no recursion over
+  // the file's graph). glTF nodes form strict trees: a node reached a second time (two parents,
+  // a cycle, a scene root that is also a child) is an error, so every node is visited at most once.
+  void add_roots(const std::vector<int>& roots) {
+    struct Pending {
+      int node;
+      glm::dmat4 parent;
+      size_t depth;
+    };
+    std::vector<Pending> stack;
+    for (auto root = roots.rbegin(); root != roots.rend(); ++root) stack.push_back({*root, glm::dmat4(1.0), 1});
+    while (!stack.empty()) {
+      const Pending pending = stack.back();
+      stack.pop_back();
+      const int node_index = pending.node;
+      if (node_index < 0 || static_cast<size_t>(node_index) >= model_.nodes.size())
+        fail(fmt::format("node {} does not exist ({} nodes)", node_index, model_.nodes.size()));
+      if (reached_[static_cast<size_t>(node_index)])
+        fail(fmt::format("node {} is reached more than once: it has more than one parent, is its own ancestor or "
+                         "is both a scene root and a child (glTF nodes form strict trees)",
+                         node_index));
+      reached_[static_cast<size_t>(node_index)] = true;
+      if (pending.depth > kMaxGltfNodeDepth)
+        fail(fmt::format("node {} is {} levels deep in the node hierarchy, over the depth limit of {}", node_index,
+                         pending.depth, kMaxGltfNodeDepth));
+      const tinygltf::Node& node = model_.nodes[static_cast<size_t>(node_index)];
+      const glm::dmat4 transform = pending.parent * node_transform(node_index, node);
+      if (!all_finite(transform))
+        fail(fmt::format("node {}: its transform combined with its parents' is not finite (overflow)", node_index));
+      if (node.mesh >= 0) add_mesh(node_index, node.mesh, transform);
+      for (auto child = node.children.rbegin(); child != node.children.rend(); ++child)
+        stack.push_back({*child, transform, pending.depth + 1});
     }
-    for (int child : node.children) add_node(child, transform, ancestors);
-    ancestors.erase(node_index);
   }
 
   Mesh finish() {
     if (mesh_.indices.empty()) fail("contains no triangles (no mesh with a TRIANGLES, TRIANGLE_STRIP or TRIANGLE_FAN primitive in the scene)");
     if (skipped_primitives_ > 0)
       log::warn("{}: skipped {} primitive(s) that are points or lines", path_.string(), skipped_primitives_);
+    if (skipped_singular_ > 0)
+      log::warn("{}: skipped {} mesh instance(s) under a singular node transform (a zero scale)", path_.string(),
+                skipped_singular_);
+    mesh_.source = path_.string();
     return std::move(mesh_);
   }
 
  private:
   [[noreturn]] void fail(const std::string& what) const { throw AssetError(fmt::format("{}: {}", path_.string(), what)); }
 
-  // Reads a VEC3 FLOAT accessor, honouring byte strides.
-  std::vector<glm::dvec3> read_vec3(int accessor_index, const std::string& where) const {
+  glm::dmat4 node_transform(int node_index, const tinygltf::Node& node) const {
+    for (const auto* values : {&node.matrix, &node.translation, &node.rotation, &node.scale})
+      if (!all_finite(*values)) fail(fmt::format("node {}: its matrix or TRS has a value that is not finite", node_index));
+    if (node.matrix.size() == 16) return glm::make_mat4(node.matrix.data());  // column-major, as glTF stores it
+    glm::dmat4 transform(1.0);
+    if (node.translation.size() == 3)
+      transform = glm::translate(transform, glm::dvec3(node.translation[0], node.translation[1], node.translation[2]));
+    if (node.rotation.size() == 4)  // glTF quaternions are x, y, z, w; glm's constructor takes w first
+      transform *= glm::mat4_cast(glm::dquat(node.rotation[3], node.rotation[0], node.rotation[1], node.rotation[2]));
+    if (node.scale.size() == 3) transform = glm::scale(transform, glm::dvec3(node.scale[0], node.scale[1], node.scale[2]));
+    return transform;
+  }
+
+  void add_mesh(int node_index, int mesh_index, const glm::dmat4& transform) {
+    if (static_cast<size_t>(mesh_index) >= model_.meshes.size())
+      fail(fmt::format("node {} names mesh {}, which does not exist", node_index, mesh_index));
+    const glm::dmat3 normal_matrix = glm::inverseTranspose(glm::dmat3(transform));
+    if (!all_finite(normal_matrix)) {  // a zero scale: nothing to see, and no normals to turn
+      ++skipped_singular_;
+      return;
+    }
+    const tinygltf::Mesh& mesh = model_.meshes[static_cast<size_t>(mesh_index)];
+    for (size_t p = 0; p < mesh.primitives.size(); ++p)
+      add_primitive(node_index, mesh_index, p, mesh.primitives[p], transform, normal_matrix);
+  }
+
+  // An accessor's elements: where the first starts, the byte step to the next, how many.
+  struct Span {
+    const unsigned char* data;
+    size_t stride;
+    size_t count;
+  };
+
+  const tinygltf::Accessor& checked_accessor(int accessor_index, const std::string& where) const {
+    if (accessor_index < 0 || static_cast<size_t>(accessor_index) >= model_.accessors.size())
+      fail(fmt::format("{}: accessor {} does not exist ({} accessors)", where, accessor_index, model_.accessors.size()));
+    const tinygltf::Accessor& accessor = model_.accessors[static_cast<size_t>(accessor_index)];
+    if (accessor.sparse.isSparse) fail(fmt::format("{}: accessor {} is sparse, which is not supported", where, accessor_index));
+    return accessor;
+  }
+
+  // Checks, with overflow-checked arithmetic, that every element lies inside the accessor's buffer
+  // view and the view inside its buffer, and that the count is within `max_count`: all before any
+  // element is read or any memory is allocated for them.
+  Span element_span(const tinygltf::Accessor& accessor, int accessor_index, const std::string& where,
+                    size_t element_size, size_t max_count, const char* limit_name) const {
+    if (accessor.bufferView < 0 || static_cast<size_t>(accessor.bufferView) >= model_.bufferViews.size())
+      fail(fmt::format("{}: accessor {} has no valid bufferView ({})", where, accessor_index, accessor.bufferView));
+    const tinygltf::BufferView& view = model_.bufferViews[static_cast<size_t>(accessor.bufferView)];
+    if (view.buffer < 0 || static_cast<size_t>(view.buffer) >= model_.buffers.size())
+      fail(fmt::format("{}: bufferView {} names buffer {}, which does not exist", where, accessor.bufferView, view.buffer));
+    const tinygltf::Buffer& buffer = model_.buffers[static_cast<size_t>(view.buffer)];
+    size_t view_end = 0;
+    if (__builtin_add_overflow(view.byteOffset, view.byteLength, &view_end) || view_end > buffer.data.size())
+      fail(fmt::format("{}: bufferView {} (byteOffset {}, byteLength {}) runs past the end of buffer {} ({} bytes)",
+                       where, accessor.bufferView, view.byteOffset, view.byteLength, view.buffer, buffer.data.size()));
+    // glTF: byteStride is 4..252 and a multiple of 4 (tinygltf checks it too); 0 means packed.
+    if (view.byteStride != 0 && (view.byteStride < 4 || view.byteStride > 252 || view.byteStride % 4 != 0))
+      fail(fmt::format("{}: bufferView {} has byteStride {} (must be 4 to 252, a multiple of 4)", where,
+                       accessor.bufferView, view.byteStride));
+    const int stride = accessor.ByteStride(view);
+    if (stride <= 0 || static_cast<size_t>(stride) < element_size)
+      fail(fmt::format("{}: accessor {} has an invalid byte stride {} for {}-byte elements (bufferView {})", where,
+                       accessor_index, stride, element_size, accessor.bufferView));
+    if (accessor.count > 0) {
+      size_t last_start = 0, end = 0;
+      if (__builtin_mul_overflow(static_cast<size_t>(stride), accessor.count - 1, &last_start) ||
+          __builtin_add_overflow(last_start, accessor.byteOffset, &last_start) ||
+          __builtin_add_overflow(last_start, element_size, &end) || end > view.byteLength)
+        fail(fmt::format("{}: accessor {} ({} elements of {} bytes, stride {}, from byteOffset {}) does not fit in "
+                         "bufferView {} ({} bytes)",
+                         where, accessor_index, accessor.count, element_size, stride, accessor.byteOffset,
+                         accessor.bufferView, view.byteLength));
+    }
+    if (accessor.count > max_count)
+      fail(fmt::format("{}: accessor {} has {} elements, over the limit of {} {}", where, accessor_index,
+                       accessor.count, max_count, limit_name));
+    return {buffer.data.data() + view.byteOffset + accessor.byteOffset, static_cast<size_t>(stride), accessor.count};
+  }
+
+  Span vec3_span(int accessor_index, const std::string& where) const {
     const tinygltf::Accessor& accessor = checked_accessor(accessor_index, where);
     if (accessor.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT || accessor.type != TINYGLTF_TYPE_VEC3)
       fail(fmt::format("{}: accessor {} must be VEC3 of FLOAT", where, accessor_index));
-    std::vector<glm::dvec3> values(accessor.count);
-    const auto [data, stride] = element_span(accessor, accessor_index, where, 12);
-    for (size_t i = 0; i < accessor.count; ++i) {
+    return element_span(accessor, accessor_index, where, 12, kMaxGltfVertices, "vertices");
+  }
+
+  // The span's VEC3 FLOAT elements, each finite.
+  std::vector<glm::dvec3> read_vec3(const Span& span, int accessor_index, const std::string& where) const {
+    std::vector<glm::dvec3> values(span.count);
+    for (size_t i = 0; i < span.count; ++i) {
       float xyz[3];
-      std::memcpy(xyz, data + i * stride, sizeof(xyz));
+      std::memcpy(xyz, span.data + i * span.stride, sizeof(xyz));
+      if (!std::isfinite(xyz[0]) || !std::isfinite(xyz[1]) || !std::isfinite(xyz[2]))
+        fail(fmt::format("{}: accessor {} element {} is not finite ({}, {}, {})", where, accessor_index, i, xyz[0],
+                         xyz[1], xyz[2]));
       values[i] = glm::dvec3(xyz[0], xyz[1], xyz[2]);
     }
     return values;
   }
 
-  std::vector<uint32_t> read_indices(int accessor_index, const std::string& where) const {
+  std::pair<Span, size_t> index_span(int accessor_index, const std::string& where) const {
     const tinygltf::Accessor& accessor = checked_accessor(accessor_index, where);
     size_t size = 0;
     switch (accessor.componentType) {
@@ -106,10 +279,14 @@ class GltfMeshCollector {
       default: fail(fmt::format("{}: index accessor {} must be UNSIGNED_BYTE, UNSIGNED_SHORT or UNSIGNED_INT", where, accessor_index));
     }
     if (accessor.type != TINYGLTF_TYPE_SCALAR) fail(fmt::format("{}: index accessor {} must be SCALAR", where, accessor_index));
-    const auto [data, stride] = element_span(accessor, accessor_index, where, size);
-    std::vector<uint32_t> indices(accessor.count);
-    for (size_t i = 0; i < accessor.count; ++i) {
-      const unsigned char* element = data + i * stride;
+    // A strip or fan of n indices makes n - 2 triangles.
+    return {element_span(accessor, accessor_index, where, size, 3 * kMaxGltfTriangles + 2, "indices"), size};
+  }
+
+  static std::vector<uint32_t> read_indices(const Span& span, size_t size) {
+    std::vector<uint32_t> indices(span.count);
+    for (size_t i = 0; i < span.count; ++i) {
+      const unsigned char* element = span.data + i * span.stride;
       if (size == 1) {
         indices[i] = element[0];
       } else if (size == 2) {
@@ -123,41 +300,14 @@ class GltfMeshCollector {
     return indices;
   }
 
-  const tinygltf::Accessor& checked_accessor(int accessor_index, const std::string& where) const {
-    if (accessor_index < 0 || static_cast<size_t>(accessor_index) >= model_.accessors.size())
-      fail(fmt::format("{}: accessor {} does not exist ({} accessors)", where, accessor_index, model_.accessors.size()));
-    const tinygltf::Accessor& accessor = model_.accessors[static_cast<size_t>(accessor_index)];
-    if (accessor.sparse.isSparse) fail(fmt::format("{}: accessor {} is sparse, which is not supported", where, accessor_index));
-    return accessor;
-  }
-
-  // Start of the accessor's first element and the byte step between elements, after checking that
-  // every element lies inside its buffer view and the view inside its buffer.
-  std::pair<const unsigned char*, size_t> element_span(const tinygltf::Accessor& accessor, int accessor_index,
-                                                       const std::string& where, size_t element_size) const {
-    if (accessor.bufferView < 0 || static_cast<size_t>(accessor.bufferView) >= model_.bufferViews.size())
-      fail(fmt::format("{}: accessor {} has no valid bufferView ({})", where, accessor_index, accessor.bufferView));
-    const tinygltf::BufferView& view = model_.bufferViews[static_cast<size_t>(accessor.bufferView)];
-    if (view.buffer < 0 || static_cast<size_t>(view.buffer) >= model_.buffers.size())
-      fail(fmt::format("{}: bufferView {} names buffer {}, which does not exist", where, accessor.bufferView, view.buffer));
-    const tinygltf::Buffer& buffer = model_.buffers[static_cast<size_t>(view.buffer)];
-    if (view.byteOffset > buffer.data.size() || view.byteLength > buffer.data.size() - view.byteOffset)
-      fail(fmt::format("{}: bufferView {} (offset {}, length {}) runs past the end of buffer {} ({} bytes)", where,
-                       accessor.bufferView, view.byteOffset, view.byteLength, view.buffer, buffer.data.size()));
-    const int stride = accessor.ByteStride(view);
-    if (stride <= 0 || static_cast<size_t>(stride) < element_size)
-      fail(fmt::format("{}: accessor {} has an invalid byte stride", where, accessor_index));
-    if (accessor.count > 0) {
-      const size_t needed = accessor.byteOffset + static_cast<size_t>(stride) * (accessor.count - 1) + element_size;
-      if (needed > view.byteLength)
-        fail(fmt::format("{}: accessor {} ({} elements from offset {}) needs {} bytes but bufferView {} has {}", where,
-                         accessor_index, accessor.count, accessor.byteOffset, needed, accessor.bufferView, view.byteLength));
-    }
-    return {buffer.data.data() + view.byteOffset + accessor.byteOffset, static_cast<size_t>(stride)};
+  static size_t triangle_count(int mode, size_t index_count) {
+    if (mode == TINYGLTF_MODE_TRIANGLES) return index_count / 3;
+    return index_count >= 3 ? index_count - 2 : 0;  // strips and fans
   }
 
   static std::vector<uint32_t> triangle_list(int mode, const std::vector<uint32_t>& indices) {
     std::vector<uint32_t> triangles;
+    triangles.reserve(3 * triangle_count(mode, indices.size()));
     if (mode == TINYGLTF_MODE_TRIANGLES) {
       triangles.assign(indices.begin(), indices.end() - static_cast<std::ptrdiff_t>(indices.size() % 3));
     } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
@@ -172,8 +322,23 @@ class GltfMeshCollector {
     return triangles;
   }
 
-  void add_primitive(int mesh_index, size_t primitive_index, const tinygltf::Primitive& primitive,
-                     const glm::dmat4& transform) {
+  // The output limits, and the elements-read budget, checked before a primitive is read.
+  void reserve_output(const std::string& where, size_t new_vertices, size_t new_triangles, size_t elements_read) {
+    size_t vertices = 0, triangles = 0;
+    if (__builtin_add_overflow(mesh_.vertex_count(), new_vertices, &vertices) || vertices > kMaxGltfVertices)
+      fail(fmt::format("{}: the mesh would have more than {} vertices, the limit (every instance of a mesh counts)",
+                       where, kMaxGltfVertices));
+    if (__builtin_add_overflow(mesh_.triangle_count(), new_triangles, &triangles) || triangles > kMaxGltfTriangles)
+      fail(fmt::format("{}: the mesh would have more than {} triangles, the limit (every instance of a mesh counts)",
+                       where, kMaxGltfTriangles));
+    if (__builtin_add_overflow(elements_read_, elements_read, &elements_read_) || elements_read_ > kMaxGltfElementsRead)
+      fail(fmt::format("{}: loading reads more than {} accessor elements, the limit (every instance of a mesh "
+                       "counts)",
+                       where, kMaxGltfElementsRead));
+  }
+
+  void add_primitive(int node_index, int mesh_index, size_t primitive_index, const tinygltf::Primitive& primitive,
+                     const glm::dmat4& transform, const glm::dmat3& normal_matrix) {
     if (primitive.mode != TINYGLTF_MODE_TRIANGLES && primitive.mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
         primitive.mode != TINYGLTF_MODE_TRIANGLE_FAN) {
       ++skipped_primitives_;
@@ -182,19 +347,31 @@ class GltfMeshCollector {
     const std::string where = fmt::format("mesh {} primitive {}", mesh_index, primitive_index);
     const auto position_attribute = primitive.attributes.find("POSITION");
     if (position_attribute == primitive.attributes.end()) fail(where + " has no POSITION attribute");
-    const std::vector<glm::dvec3> positions = read_vec3(position_attribute->second, where + " POSITION");
+    const Span positions_span = vec3_span(position_attribute->second, where + " POSITION");
 
-    std::vector<glm::dvec3> normals;
     const auto normal_attribute = primitive.attributes.find("NORMAL");
-    if (normal_attribute != primitive.attributes.end()) {
-      normals = read_vec3(normal_attribute->second, where + " NORMAL");
-      if (normals.size() != positions.size())
-        fail(fmt::format("{}: NORMAL has {} elements but POSITION has {}", where, normals.size(), positions.size()));
+    const bool has_normals = normal_attribute != primitive.attributes.end();
+    Span normals_span{nullptr, 0, 0};
+    if (has_normals) {
+      normals_span = vec3_span(normal_attribute->second, where + " NORMAL");
+      if (normals_span.count != positions_span.count)
+        fail(fmt::format("{}: NORMAL has {} elements but POSITION has {}", where, normals_span.count,
+                         positions_span.count));
     }
+    Span indices_span{nullptr, 0, positions_span.count};  // without indices: the vertices in order
+    size_t index_size = 0;
+    if (primitive.indices >= 0) std::tie(indices_span, index_size) = index_span(primitive.indices, where + " indices");
 
+    const size_t triangles_out = triangle_count(primitive.mode, indices_span.count);
+    reserve_output(where, has_normals ? positions_span.count : 3 * triangles_out, triangles_out,
+                   positions_span.count + normals_span.count + (index_size > 0 ? indices_span.count : 0));
+
+    const std::vector<glm::dvec3> positions = read_vec3(positions_span, position_attribute->second, where + " POSITION");
+    std::vector<glm::dvec3> normals;
+    if (has_normals) normals = read_vec3(normals_span, normal_attribute->second, where + " NORMAL");
     std::vector<uint32_t> indices;
-    if (primitive.indices >= 0) {
-      indices = read_indices(primitive.indices, where + " indices");
+    if (index_size > 0) {
+      indices = read_indices(indices_span, index_size);
     } else {
       indices.resize(positions.size());
       for (size_t i = 0; i < indices.size(); ++i) indices[i] = static_cast<uint32_t>(i);
@@ -212,12 +389,19 @@ class GltfMeshCollector {
       const std::vector<double>& factor =
           model_.materials[static_cast<size_t>(primitive.material)].pbrMetallicRoughness.baseColorFactor;
       if (factor.size() == 4)
-        for (size_t c = 0; c < 4; ++c) color[c] = static_cast<float>(factor[c]);
+        for (size_t c = 0; c < 4; ++c) color[c] = static_cast<float>(std::isfinite(factor[c]) ? factor[c] : 1.0);
     }
 
-    const glm::dmat3 normal_matrix = glm::inverseTranspose(glm::dmat3(transform));
     // glTF is y-up with the model's front towards +z; the object frame is z-up (x stays x).
     auto to_object_frame = [](const glm::dvec3& v) { return glm::dvec3(v.x, -v.z, v.y); };
+    auto place = [&](const glm::dvec3& position, size_t vertex) {
+      const glm::dvec3 placed = to_object_frame(glm::dvec3(transform * glm::dvec4(position, 1.0)));
+      for (int axis = 0; axis < 3; ++axis)
+        if (!std::isfinite(static_cast<float>(placed[axis])))
+          fail(fmt::format("node {} {}: vertex {} is ({}, {}, {}) after the node's transform, beyond float range",
+                           node_index, where, vertex, placed.x, placed.y, placed.z));
+      return placed;
+    };
     auto push = [&](std::vector<float>& out, const glm::dvec3& v) {
       out.insert(out.end(), {static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z)});
     };
@@ -225,10 +409,10 @@ class GltfMeshCollector {
     MeshPart part;
     part.first_index = static_cast<uint32_t>(mesh_.indices.size());
     part.base_color = color;
-    if (!normals.empty()) {
+    if (has_normals) {
       const uint32_t base = static_cast<uint32_t>(mesh_.vertex_count());
       for (size_t i = 0; i < positions.size(); ++i) {
-        push(mesh_.positions, to_object_frame(glm::dvec3(transform * glm::dvec4(positions[i], 1.0))));
+        push(mesh_.positions, place(positions[i], i));
         glm::dvec3 n = normal_matrix * normals[i];
         if (glm::length(n) > 0) n = glm::normalize(n);
         push(mesh_.normals, to_object_frame(n));
@@ -242,11 +426,11 @@ class GltfMeshCollector {
       // Flat normals: every triangle gets its own three vertices.
       for (size_t i = 0; i < triangles.size(); i += 3) {
         glm::dvec3 corner[3];
-        for (size_t k = 0; k < 3; ++k)
-          corner[k] = to_object_frame(glm::dvec3(transform * glm::dvec4(positions[triangles[i + k]], 1.0)));
+        for (size_t k = 0; k < 3; ++k) corner[k] = place(positions[triangles[i + k]], triangles[i + k]);
         if (mirrored) std::swap(corner[1], corner[2]);
         glm::dvec3 n = glm::cross(corner[1] - corner[0], corner[2] - corner[0]);
-        if (glm::length(n) > 0) n = glm::normalize(n);
+        const double length = glm::length(n);
+        n = length > 0 && std::isfinite(length) ? n / length : glm::dvec3(0.0);
         for (size_t k = 0; k < 3; ++k) {
           mesh_.indices.push_back(static_cast<uint32_t>(mesh_.vertex_count()));
           push(mesh_.positions, corner[k]);
@@ -260,57 +444,70 @@ class GltfMeshCollector {
 
   const tinygltf::Model& model_;
   const std::filesystem::path& path_;
+  std::vector<bool> reached_;  // per node: already placed once
   Mesh mesh_;
   int skipped_primitives_ = 0;
+  int skipped_singular_ = 0;
+  uint64_t elements_read_ = 0;
 };
 
-bool starts_with_glb_magic(const std::filesystem::path& path) {
-  std::ifstream file(path, std::ios::binary);
-  char magic[4] = {};
-  file.read(magic, 4);
-  return file.gcount() == 4 && std::memcmp(magic, "glTF", 4) == 0;
+// The scene's root nodes: the default scene's, else the first scene's, else every node that is
+// nobody's child.
+std::vector<int> root_nodes(const tinygltf::Model& model) {
+  if (model.defaultScene >= 0 && static_cast<size_t>(model.defaultScene) < model.scenes.size())
+    return model.scenes[static_cast<size_t>(model.defaultScene)].nodes;
+  if (!model.scenes.empty()) return model.scenes.front().nodes;
+  std::vector<bool> is_child(model.nodes.size(), false);
+  for (const tinygltf::Node& node : model.nodes)
+    for (int child : node.children)
+      if (child >= 0 && static_cast<size_t>(child) < is_child.size()) is_child[static_cast<size_t>(child)] = true;
+  std::vector<int> roots;
+  for (size_t i = 0; i < model.nodes.size(); ++i)
+    if (!is_child[i]) roots.push_back(static_cast<int>(i));
+  return roots;
+}
+
+Mesh load_checked_gltf_mesh(const std::filesystem::path& path) {
+  GltfDocument document = read_gltf_document(path);
+  ExternalFiles external{document.folder, kMaxGltfBufferBytes};
+  tinygltf::TinyGLTF loader;
+  loader.SetImageLoader(ignore_image, nullptr);
+  loader.SetFsCallbacks({external_file_exists, keep_file_path, read_external_file, refuse_write, &external});
+  tinygltf::Model model;
+  std::string error, warning;
+  const std::string base_dir = document.folder.string();
+  const bool ok =
+      document.binary
+          ? loader.LoadBinaryFromMemory(&model, &error, &warning, document.glb.data(),
+                                        static_cast<unsigned int>(document.glb.size()), base_dir)
+          : loader.LoadASCIIFromString(&model, &error, &warning, document.json.data(),
+                                       static_cast<unsigned int>(document.json.size()), base_dir);
+  const bool binary = document.binary;
+  document = {};  // the parsed model holds what is needed
+  if (!ok)
+    throw AssetError(fmt::format("{}: not a valid glTF 2.0 {} file: {}", path.string(),
+                                 binary ? "binary (.glb)" : "JSON", tinygltf_message(error)));
+  if (!warning.empty()) log::debug("{}: tinygltf: {}", path.string(), tinygltf_message(warning));
+
+  GltfMeshCollector collector(model, path);
+  collector.add_roots(root_nodes(model));
+  return collector.finish();
 }
 
 }  // namespace
 
 Mesh load_gltf_mesh(const std::filesystem::path& path) {
-  {
-    std::ifstream probe(path, std::ios::binary);
-    if (!probe) throw AssetError(fmt::format("{}: cannot open glTF file: {}", path.string(), std::strerror(errno)));
+  // Every failure is an AssetError naming the file: the limits above keep allocations small, and
+  // this is the last line for what they do not foresee.
+  try {
+    return load_checked_gltf_mesh(path);
+  } catch (const AssetError&) {
+    throw;
+  } catch (const std::bad_alloc&) {
+    throw AssetError(fmt::format("{}: out of memory while loading the glTF file", path.string()));
+  } catch (const std::exception& e) {
+    throw AssetError(fmt::format("{}: cannot load the glTF file: {}", path.string(), e.what()));
   }
-  if (std::filesystem::is_directory(path)) throw AssetError(fmt::format("{}: is a directory, not a glTF file", path.string()));
-
-  tinygltf::TinyGLTF loader;
-  loader.SetImageLoader(ignore_image, nullptr);
-  tinygltf::Model model;
-  std::string error, warning;
-  const bool binary = starts_with_glb_magic(path);
-  const bool ok = binary ? loader.LoadBinaryFromFile(&model, &error, &warning, path.string())
-                         : loader.LoadASCIIFromFile(&model, &error, &warning, path.string());
-  if (!ok) {
-    if (error.empty()) error = "unknown error";
-    throw AssetError(fmt::format("{}: not a valid glTF 2.0 {} file: {}", path.string(), binary ? "binary (.glb)" : "JSON",
-                                 trimmed(error)));
-  }
-  if (!warning.empty()) log::debug("{}: tinygltf: {}", path.string(), trimmed(warning));
-
-  GltfMeshCollector collector(model, path);
-  std::vector<int> roots;
-  if (model.defaultScene >= 0 && static_cast<size_t>(model.defaultScene) < model.scenes.size()) {
-    roots = model.scenes[static_cast<size_t>(model.defaultScene)].nodes;
-  } else if (!model.scenes.empty()) {
-    roots = model.scenes.front().nodes;
-  } else {
-    std::vector<bool> is_child(model.nodes.size(), false);
-    for (const tinygltf::Node& node : model.nodes)
-      for (int child : node.children)
-        if (child >= 0 && static_cast<size_t>(child) < is_child.size()) is_child[static_cast<size_t>(child)] = true;
-    for (size_t i = 0; i < model.nodes.size(); ++i)
-      if (!is_child[i]) roots.push_back(static_cast<int>(i));
-  }
-  std::set<int> ancestors;
-  for (int root : roots) collector.add_node(root, glm::dmat4(1.0), ancestors);
-  return collector.finish();
 }
 
 }  // namespace arpipe

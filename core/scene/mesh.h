@@ -27,6 +27,9 @@ struct Mesh {
   std::vector<float> normals;    // unit, x, y, z per vertex
   std::vector<uint32_t> indices; // three per triangle, counter-clockwise seen from outside
   std::vector<MeshPart> parts;
+  // Where the mesh came from (the glTF file's path, "builtin:cube", ...), for messages about it;
+  // not part of its content (the PRT cache key ignores it). Empty when unknown.
+  std::string source;
 
   size_t vertex_count() const { return positions.size() / 3; }
   size_t triangle_count() const { return indices.size() / 3; }

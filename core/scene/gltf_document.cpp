@@ -1,0 +1,263 @@
+// The checks a glTF file passes before tinygltf parses it: the GLB container, JSON nesting and
+// size, counts and buffer bytes within gltf_limits.h, external buffers inside the file's folder.
+#include "core/scene/gltf_document.h"
+
+#include <fmt/format.h>
+
+#include <array>
+#include <cstring>
+#include <nlohmann/json.hpp>
+#include <string_view>
+
+#include "core/scene/asset_error.h"
+#include "core/scene/asset_file.h"
+#include "core/scene/gltf_limits.h"
+
+namespace arpipe {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+constexpr uint32_t kGlbMagic = 0x46546C67;       // "glTF"
+constexpr uint32_t kJsonChunkType = 0x4E4F534A;  // "JSON"
+constexpr uint32_t kBinChunkType = 0x004E4942;   // "BIN\0"
+constexpr size_t kGlbHeaderBytes = 12, kChunkHeaderBytes = 8;
+
+class DocumentReader {
+ public:
+  explicit DocumentReader(const fs::path& path) : path_(path) {}
+
+  GltfDocument read() {
+    std::string why;
+    std::optional<std::vector<unsigned char>> bytes = read_regular_file(path_, kMaxGlbFileBytes, &why);
+    if (!bytes) fail(fmt::format("cannot read the glTF file: {}", why));
+    std::optional<fs::path> folder = canonical_folder(path_, &why);
+    if (!folder) fail(why);
+    document_.folder = std::move(*folder);
+    document_.binary = bytes->size() >= 4 && read_u32(*bytes, 0) == kGlbMagic;
+    if (document_.binary) {
+      document_.glb = std::move(*bytes);
+      read_glb();
+    } else {
+      if (bytes->size() > kMaxGltfJsonBytes)
+        fail(fmt::format("{} bytes of glTF JSON, over the limit of {} bytes (keep large buffers in a .bin file or "
+                         "a .glb)",
+                         bytes->size(), kMaxGltfJsonBytes));
+      document_.json = clean_json(std::string_view(reinterpret_cast<const char*>(bytes->data()), bytes->size()), 0);
+    }
+    return std::move(document_);
+  }
+
+ private:
+  [[noreturn]] void fail(const std::string& what) const { throw AssetError(fmt::format("{}: {}", path_.string(), what)); }
+
+  static uint32_t read_u32(const std::vector<unsigned char>& bytes, size_t at) {
+    return uint32_t(bytes[at]) | uint32_t(bytes[at + 1]) << 8 | uint32_t(bytes[at + 2]) << 16 |
+           uint32_t(bytes[at + 3]) << 24;
+  }
+  static void write_u32(std::vector<unsigned char>& bytes, size_t at, uint32_t v) {
+    for (size_t i = 0; i < 4; ++i) bytes[at + i] = static_cast<unsigned char>((v >> (8 * i)) & 0xffu);
+  }
+
+  // GLB: a 12-byte header (magic, version 2, length), a JSON chunk, an optional BIN chunk; every
+  // length is checked against the bytes really there (64-bit sums: no wrap).
+  void read_glb() {
+    std::vector<unsigned char>& glb = document_.glb;
+    const uint64_t size = glb.size();
+    if (size < kGlbHeaderBytes + kChunkHeaderBytes)
+      fail(fmt::format("a binary glTF (.glb) of {} bytes: the header and JSON chunk header need {}", size,
+                       kGlbHeaderBytes + kChunkHeaderBytes));
+    const uint32_t version = read_u32(glb, 4), length = read_u32(glb, 8);
+    if (version != 2) fail(fmt::format("binary glTF (.glb) version {}, expected 2", version));
+    if (length > size || length < kGlbHeaderBytes + kChunkHeaderBytes)
+      fail(fmt::format("binary glTF (.glb) header (byte 8) gives a length of {} bytes, the file has {}", length, size));
+    const uint64_t json_length = read_u32(glb, 12);
+    if (read_u32(glb, 16) != kJsonChunkType) fail("binary glTF (.glb): the first chunk (byte 12) is not a JSON chunk");
+    const uint64_t json_end = kGlbHeaderBytes + kChunkHeaderBytes + json_length;
+    if (json_length == 0 || json_end > length)
+      fail(fmt::format("binary glTF (.glb): the JSON chunk (byte 12) declares {} bytes, but {} remain in the file",
+                       json_length, length - kGlbHeaderBytes - kChunkHeaderBytes));
+    if (json_length > kMaxGltfJsonBytes)
+      fail(fmt::format("binary glTF (.glb): the JSON chunk has {} bytes, over the limit of {} bytes", json_length,
+                       kMaxGltfJsonBytes));
+    uint64_t bin_length = 0;
+    if (json_end < length) {
+      if (json_end + kChunkHeaderBytes > length)
+        fail(fmt::format("binary glTF (.glb): {} bytes after the JSON chunk (byte {}) are too few for a chunk header",
+                         length - json_end, json_end));
+      bin_length = read_u32(glb, json_end);
+      if (read_u32(glb, json_end + 4) != kBinChunkType)
+        fail(fmt::format("binary glTF (.glb): the chunk at byte {} is not a BIN chunk", json_end));
+      if (json_end + kChunkHeaderBytes + bin_length > length)
+        fail(fmt::format("binary glTF (.glb): the BIN chunk (byte {}) declares {} bytes, but {} remain in the file",
+                         json_end, bin_length, length - json_end - kChunkHeaderBytes));
+    }
+    bin_bytes_ = bin_length;
+    const std::string cleaned = clean_json(
+        std::string_view(reinterpret_cast<const char*>(glb.data()) + kGlbHeaderBytes + kChunkHeaderBytes,
+                         size_t(json_length)),
+        kGlbHeaderBytes + kChunkHeaderBytes);
+    // The GLB tinygltf parses: the cleaned JSON (space-padded) and the BIN chunk, nothing after.
+    const uint64_t bin_part = bin_length > 0 ? kChunkHeaderBytes + bin_length : 0;
+    if (cleaned.size() <= json_length) {
+      std::memcpy(glb.data() + kGlbHeaderBytes + kChunkHeaderBytes, cleaned.data(), cleaned.size());
+      std::memset(glb.data() + kGlbHeaderBytes + kChunkHeaderBytes + cleaned.size(), ' ', json_length - cleaned.size());
+      glb.resize(size_t(json_end + bin_part));
+    } else {  // rare: the cleaned JSON is longer (numbers written out), so the BIN chunk moves
+      const uint64_t padded = (cleaned.size() + 3) / 4 * 4;
+      std::vector<unsigned char> rebuilt(size_t(kGlbHeaderBytes + kChunkHeaderBytes + padded + bin_part), ' ');
+      std::memcpy(rebuilt.data(), glb.data(), kGlbHeaderBytes);
+      write_u32(rebuilt, 12, uint32_t(padded));
+      write_u32(rebuilt, 16, kJsonChunkType);
+      std::memcpy(rebuilt.data() + kGlbHeaderBytes + kChunkHeaderBytes, cleaned.data(), cleaned.size());
+      if (bin_part > 0)
+        std::memcpy(rebuilt.data() + kGlbHeaderBytes + kChunkHeaderBytes + padded, glb.data() + json_end, bin_part);
+      glb = std::move(rebuilt);
+    }
+    write_u32(glb, 8, uint32_t(glb.size()));
+  }
+
+  // Array and object nesting, counted outside strings, before a parser (or tinygltf's recursion
+  // over "extras") sees it.
+  void check_nesting(std::string_view text, size_t file_offset) const {
+    int depth = 0;
+    bool in_string = false, escaped = false;
+    for (size_t i = 0; i < text.size(); ++i) {
+      const char c = text[i];
+      if (in_string) {
+        if (escaped) escaped = false;
+        else if (c == '\\') escaped = true;
+        else if (c == '"') in_string = false;
+      } else if (c == '"') {
+        in_string = true;
+      } else if (c == '[' || c == '{') {
+        if (++depth > kMaxGltfJsonDepth)
+          fail(fmt::format("JSON nests arrays and objects more than {} levels deep (at byte {})", kMaxGltfJsonDepth,
+                           file_offset + i));
+      } else if (c == ']' || c == '}') {
+        --depth;
+      }
+    }
+  }
+
+  std::string clean_json(std::string_view text, size_t file_offset) {
+    check_nesting(text, file_offset);
+    json gltf;
+    try {
+      gltf = json::parse(text.begin(), text.end());
+    } catch (const json::exception& e) {  // the message gives the line and column
+      std::string what = e.what();
+      if (const size_t at = what.find("] "); at != std::string::npos) what.erase(0, at + 2);
+      if (what.size() > 300) what = what.substr(0, 300) + "...";
+      fail(fmt::format("not a valid glTF 2.0 {} file: {}", document_.binary ? "binary (.glb)" : "JSON", what));
+    }
+    if (!gltf.is_object())
+      fail(fmt::format("not a valid glTF 2.0 {} file: the JSON is not an object",
+                       document_.binary ? "binary (.glb)" : "JSON"));
+    for (const char* unused : {"images", "textures", "samplers", "animations", "skins", "cameras"}) gltf.erase(unused);
+    drop_extras_and_extensions(gltf);
+    for (const char* name : {"nodes", "meshes", "accessors", "bufferViews", "buffers", "materials", "scenes"}) {
+      const auto it = gltf.find(name);
+      if (it != gltf.end() && it->is_array() && it->size() > kMaxGltfArrayEntries)
+        fail(fmt::format("\"{}\" has {} entries, over the limit of {}", name, it->size(), kMaxGltfArrayEntries));
+    }
+    if (const auto meshes = gltf.find("meshes"); meshes != gltf.end() && meshes->is_array())
+      for (size_t m = 0; m < meshes->size(); ++m) {
+        const json& mesh = (*meshes)[m];
+        if (!mesh.is_object()) continue;
+        const auto primitives = mesh.find("primitives");
+        if (primitives != mesh.end() && primitives->is_array() && primitives->size() > kMaxGltfArrayEntries)
+          fail(fmt::format("mesh {} has {} primitives, over the limit of {}", m, primitives->size(),
+                           kMaxGltfArrayEntries));
+      }
+    check_buffers(gltf);
+    return gltf.dump();
+  }
+
+  // "extras" and "extensions" anywhere: iteratively, with a stack of the objects still to visit.
+  static void drop_extras_and_extensions(json& root) {
+    std::vector<json*> pending{&root};
+    while (!pending.empty()) {
+      json* value = pending.back();
+      pending.pop_back();
+      if (value->is_object()) {
+        value->erase("extras");
+        value->erase("extensions");
+      }
+      if (value->is_structured())
+        for (json& child : *value) pending.push_back(&child);
+    }
+  }
+
+  // The declared bytes of all buffers against the limit; each external one resolved inside the
+  // folder, a regular file of its byteLength (tinygltf then reads it through the loader's checked
+  // callbacks, which apply the same rules again).
+  void check_buffers(const json& gltf) const {
+    const auto buffers = gltf.find("buffers");
+    if (buffers == gltf.end() || !buffers->is_array()) return;
+    uint64_t total = 0;
+    for (size_t b = 0; b < buffers->size(); ++b) {
+      const json& buffer = (*buffers)[b];
+      if (!buffer.is_object()) continue;
+      const auto length = buffer.find("byteLength");
+      if (length == buffer.end() || !length->is_number_unsigned()) continue;  // tinygltf says what is wrong
+      const uint64_t bytes = length->get<uint64_t>();
+      if (__builtin_add_overflow(total, bytes, &total) || total > kMaxGltfBufferBytes)
+        fail(fmt::format("buffer {} brings the buffers' byteLength to more than the limit of {} bytes", b,
+                         kMaxGltfBufferBytes));
+      const auto uri = buffer.find("uri");
+      if (uri == buffer.end() || !uri->is_string()) {
+        if (document_.binary && b == 0 && bytes > bin_bytes_)
+          fail(fmt::format("buffer 0 declares {} bytes, but the BIN chunk has {}", bytes, bin_bytes_));
+        continue;
+      }
+      const std::string& text = uri->get_ref<const std::string&>();
+      if (text.rfind("data:", 0) == 0) continue;  // embedded: bounded by the JSON's size
+      std::string why;
+      const std::optional<fs::path> file = resolve_inside_folder(document_.folder, decode_uri(text), &why);
+      const std::string shown = text.size() > 200 ? text.substr(0, 200) + "..." : text;
+      if (!file) fail(fmt::format("buffer {} (uri \"{}\"): {}", b, shown, why));
+      std::error_code error;
+      const fs::file_status status = fs::status(*file, error);
+      if (error || !fs::is_regular_file(status))
+        fail(fmt::format("buffer {} (uri \"{}\"): not a regular file", b, shown));
+      const uintmax_t size = fs::file_size(*file, error);
+      if (error) fail(fmt::format("buffer {} (uri \"{}\"): cannot read its size: {}", b, shown, error.message()));
+      if (size != bytes)
+        fail(fmt::format("buffer {} (uri \"{}\"): the file has {} bytes, byteLength says {}", b, shown, size, bytes));
+    }
+  }
+
+  const fs::path& path_;
+  GltfDocument document_;
+  uint64_t bin_bytes_ = 0;
+};
+
+}  // namespace
+
+std::string decode_uri(const std::string& uri) {
+  // tinygltf's own decoding (dlib's urldecode): '+' is a space, %XX a byte.
+  auto hex = [](char c) -> int {
+    if (c >= '0' && c <= '9') return c - '0';
+    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+    return 0;
+  };
+  std::string out;
+  for (size_t i = 0; i < uri.size(); ++i) {
+    if (uri[i] == '+') {
+      out += ' ';
+    } else if (uri[i] == '%' && uri.size() > i + 2) {
+      out += static_cast<char>((hex(uri[i + 1]) << 4) | hex(uri[i + 2]));
+      i += 2;
+    } else {
+      out += uri[i];
+    }
+  }
+  return out;
+}
+
+GltfDocument read_gltf_document(const fs::path& path) { return DocumentReader(path).read(); }
+
+}  // namespace arpipe
