@@ -20,16 +20,31 @@ all_targets=(fuzz_gltf fuzz_config fuzz_sim_scene fuzz_board fuzz_recording fuzz
 # modules' own bad-input corpora where they exist (libFuzzer reads corpus folders recursively).
 declare -A extra_seeds=(
   [fuzz_gltf]="tests/scene/corpus"
-  [fuzz_config]="configs tests/core/corpus"
-  [fuzz_sim_scene]="configs/sim tests/capture/corpus"
-  [fuzz_board]="configs/boards"
-  [fuzz_recording]="tests/capture/corpus"
-  [fuzz_radiance_hdr]="tests/core/corpus"
-  [fuzz_openexr]="tests/core/corpus"
-  [fuzz_png_jpeg]="tests/capture/corpus"
-  [fuzz_cameramodel]="tests/core/corpus"
-  [fuzz_prt_cache]=""
+  [fuzz_config]="configs tests/core/corpus/config"
+  [fuzz_sim_scene]="configs/sim tests/capture/corpus/sim"
+  [fuzz_board]="configs/boards tests/calib/corpus"
+  [fuzz_recording]=""  # recording folders are joined into the target's one-file form below
+  [fuzz_radiance_hdr]="tests/hdr/corpus tests/core/corpus/hdr"
+  [fuzz_openexr]="tests/hdr/corpus tests/core/corpus/hdr"
+  [fuzz_png_jpeg]="tests/capture/corpus/images"
+  [fuzz_cameramodel]="tests/core/corpus/cameramodel"
+  [fuzz_prt_cache]="tests/prt/corpus"
 )
+# fuzz_recording reads one file: a recording's parts joined by its separator line
+# (tests/fuzz/fuzz_recording.cpp); every recording folder under tests/capture/corpus becomes one.
+join_recordings() {
+  local out=$1 dir part n=0
+  local separator=$'\n--arpipe-fuzz-part--\n'
+  while IFS= read -r dir; do
+    dir=$(dirname "$dir")
+    n=$((n + 1))
+    for part in recording.json camera.cameramodel frames.jsonl ground_truth.jsonl; do
+      if [ -f "$dir/$part" ]; then cat "$dir/$part"; fi
+      printf '%s' "$separator"
+    done >"$out/joined-$n"
+    if [ -f "$dir/frames.bin" ]; then cat "$dir/frames.bin" >>"$out/joined-$n"; fi
+  done < <(find tests/capture/corpus -name recording.json 2>/dev/null)
+}
 # The limits every run holds the parsers to (issue 18): a crash, a hang over 10 s, an allocation
 # over 1 GB or a resident size over 2 GB is a finding. close_fd_mask=3 silences the parsers'
 # stdout/stderr (libFuzzer keeps its own and the sanitizers' reports).
@@ -113,6 +128,11 @@ for t in "${targets[@]}"; do
   mkdir -p "$work"
   seeds=(tests/fuzz/corpus/"$t")
   for d in ${extra_seeds[$t]}; do [ -d "$d" ] && seeds+=("$d"); done
+  if [ "$t" = fuzz_recording ]; then
+    mkdir -p "$scratch/joined-recordings"
+    join_recordings "$scratch/joined-recordings"
+    seeds+=("$scratch/joined-recordings")
+  fi
   dict=()
   [ -f "tests/fuzz/dict/$t.dict" ] && dict=(-dict="tests/fuzz/dict/$t.dict")
   start=$(date +%s.%N)
