@@ -148,36 +148,41 @@ void check_settings(const PrtBakeSettings& s) {
     throw std::invalid_argument(fmt::format("PRT bake: ray offset must be finite and >= 0, got {}", s.ray_offset));
 }
 
+// "<mesh file>: PRT bake: <what>", so that a bad vertex is traced to its file.
+AssetError mesh_error(const Mesh& mesh, const std::string& what) {
+  return AssetError(mesh.source.empty() ? fmt::format("PRT bake: {}", what)
+                                        : fmt::format("{}: PRT bake: {}", mesh.source, what));
+}
+
 }  // namespace
 
 void validate_prt_mesh(const Mesh& mesh) {
   if (mesh.positions.size() % 3 != 0)
-    throw AssetError(fmt::format("PRT bake: {} position values is not a multiple of 3", mesh.positions.size()));
+    throw mesh_error(mesh, fmt::format("{} position values is not a multiple of 3", mesh.positions.size()));
   if (mesh.normals.size() != mesh.positions.size())
-    throw AssetError(fmt::format("PRT bake: the mesh has {} normals for {} vertices (one normal per vertex needed)",
-                                 mesh.normals.size() / 3, mesh.vertex_count()));
+    throw mesh_error(mesh, fmt::format("the mesh has {} normals for {} vertices (one normal per vertex needed)",
+                                       mesh.normals.size() / 3, mesh.vertex_count()));
   if (mesh.indices.size() % 3 != 0)
-    throw AssetError(
-        fmt::format("PRT bake: {} indices is not a multiple of 3 (triangle lists only)", mesh.indices.size()));
+    throw mesh_error(mesh, fmt::format("{} indices is not a multiple of 3 (triangle lists only)", mesh.indices.size()));
   for (size_t v = 0; v < mesh.vertex_count(); ++v) {
     const Vec3 p = vec_at(mesh.positions, v), n = vec_at(mesh.normals, v);
     if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
-      throw AssetError(fmt::format("PRT bake: vertex {} has a non-finite position ({}, {}, {})", v, p[0], p[1], p[2]));
+      throw mesh_error(mesh, fmt::format("vertex {} has a non-finite position ({}, {}, {})", v, p[0], p[1], p[2]));
     if (!std::isfinite(n[0]) || !std::isfinite(n[1]) || !std::isfinite(n[2]))
-      throw AssetError(fmt::format("PRT bake: vertex {} has a non-finite normal ({}, {}, {})", v, n[0], n[1], n[2]));
+      throw mesh_error(mesh, fmt::format("vertex {} has a non-finite normal ({}, {}, {})", v, n[0], n[1], n[2]));
     if (norm(n) < 1e-6)
-      throw AssetError(fmt::format("PRT bake: vertex {} has a zero-length normal", v));
+      throw mesh_error(mesh, fmt::format("vertex {} has a zero-length normal", v));
   }
   for (size_t i = 0; i < mesh.indices.size(); ++i)
     if (mesh.indices[i] >= mesh.vertex_count())
-      throw AssetError(fmt::format("PRT bake: index {} (triangle {}) is {}, out of range for {} vertices", i, i / 3,
-                                   mesh.indices[i], mesh.vertex_count()));
+      throw mesh_error(mesh, fmt::format("index {} (triangle {}) is {}, out of range for {} vertices", i, i / 3,
+                                         mesh.indices[i], mesh.vertex_count()));
   for (size_t p = 0; p < mesh.parts.size(); ++p) {
     const MeshPart& part = mesh.parts[p];
     if (uint64_t(part.first_index) + part.index_count > mesh.indices.size())
-      throw AssetError(fmt::format("PRT bake: part {} covers indices [{}, {}), beyond the {} indices", p,
-                                   part.first_index, uint64_t(part.first_index) + part.index_count,
-                                   mesh.indices.size()));
+      throw mesh_error(mesh, fmt::format("part {} covers indices [{}, {}), beyond the {} indices", p,
+                                         part.first_index, uint64_t(part.first_index) + part.index_count,
+                                         mesh.indices.size()));
   }
 }
 

@@ -48,7 +48,8 @@ PrtTransfer bake_prt(const Mesh& mesh, const PrtBakeSettings& settings,
                      const std::function<void(size_t done, size_t total)>& progress = {},
                      PrtBakeStats* stats = nullptr);
 
-// The checks bake_prt makes before it starts (AssetError naming the vertex or index and what is wrong).
+// The checks bake_prt makes before it starts (AssetError naming the mesh's file, Mesh::source, when
+// known, the vertex or index and what is wrong).
 void validate_prt_mesh(const Mesh& mesh);
 
 }  // namespace arpipe

@@ -2,6 +2,7 @@
 #include "render/prt/prt_cache.h"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <fmt/format.h>
 #include <unistd.h>
 #include <xxhash.h>
@@ -13,6 +14,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <string_view>
@@ -138,20 +140,45 @@ std::string prt_cache_key(const Mesh& mesh, const PrtBakeSettings& settings) {
 
 fs::path prt_cache_file(const fs::path& cache_dir, const std::string& key) { return cache_dir / (key + ".prt"); }
 
-std::optional<PrtTransfer> read_prt_cache(const fs::path& file, const std::string& key, std::string* why_not) {
-  std::error_code error;
-  if (!fs::exists(file, error)) return reject(why_not, fmt::format("{}: no cache file", file.string()));
-  std::string data;
-  {
-    std::ifstream in(file, std::ios::binary);
-    if (!in) return reject(why_not, fmt::format("{}: cannot open: {}", file.string(), errno_text()));
-    data.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-    if (in.bad()) return reject(why_not, fmt::format("{}: read error", file.string()));
+namespace {
+
+// Reads exactly `size` bytes at the file's current position (false on error or early end).
+bool read_exactly(int fd, char* out, size_t size) {
+  for (size_t done = 0; done < size;) {
+    const ssize_t n = ::read(fd, out + done, size - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return false;
+    done += size_t(n);
   }
+  return true;
+}
+
+std::optional<PrtTransfer> read_checked_prt_cache(const fs::path& file, const std::string& key, std::string* why_not,
+                                                  const std::optional<PrtCacheShape>& expected) {
+  // O_NONBLOCK: a FIFO in the cache directory must not block the open; fstat then refuses it.
+  const int fd = ::open(file.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+  if (fd < 0) {
+    if (errno == ENOENT) return reject(why_not, fmt::format("{}: no cache file", file.string()));
+    return reject(why_not, fmt::format("{}: cannot open: {}", file.string(), errno_text()));
+  }
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
+  struct stat info {};
+  if (::fstat(fd, &info) != 0) return reject(why_not, fmt::format("{}: cannot stat: {}", file.string(), errno_text()));
+  if (!S_ISREG(info.st_mode)) return reject(why_not, fmt::format("{}: not a regular file", file.string()));
+  const uint64_t size = uint64_t(std::max<off_t>(info.st_size, 0));
+  if (size > kMaxPrtCacheBytes)
+    return reject(why_not, fmt::format("{}: {} bytes, over the limit of {} bytes for a cache file", file.string(), size,
+                                       kMaxPrtCacheBytes));
+  // The header first: the size it implies is checked against the file before the body is read.
+  std::string data(std::min<uint64_t>(size, kHeaderBytes), '\0');
+  if (!read_exactly(fd, data.data(), data.size())) return reject(why_not, fmt::format("{}: read error", file.string()));
   if (data.size() < kMagic.size() || std::string_view(data).substr(0, kMagic.size()) != kMagic)
     return reject(why_not, fmt::format("{}: not a PRT cache file (no \"ARPIPE-PRT\" magic)", file.string()));
-  if (data.size() < kHeaderBytes + kChecksumBytes)
-    return reject(why_not, fmt::format("{}: truncated ({} bytes, the header alone is {})", file.string(), data.size(),
+  if (size < kHeaderBytes + kChecksumBytes)
+    return reject(why_not, fmt::format("{}: truncated ({} bytes, the header alone is {})", file.string(), size,
                                        kHeaderBytes + kChecksumBytes));
   const uint32_t version = get_u32(data, 11);
   if (version != kPrtCacheVersion)
@@ -163,16 +190,22 @@ std::optional<PrtTransfer> read_prt_cache(const fs::path& file, const std::strin
   const uint32_t samples = get_u32(data, 63);
   if (bands < 1 || bands > uint32_t(kMaxShBands) || kind > 2)
     return reject(why_not, fmt::format("{}: corrupt header (kind {}, bands {})", file.string(), kind, bands));
+  if (expected && (vertices != expected->vertices || int(bands) != expected->bands))
+    return reject(why_not, fmt::format("{}: does not fit the mesh ({} vertices of {} bands, {} of {} expected)",
+                                       file.string(), vertices, bands, expected->vertices, expected->bands));
   const uint64_t per_vertex = uint64_t(bands) * bands * 4;
-  if (vertices > (data.size() - kHeaderBytes - kChecksumBytes) / per_vertex)
-    return reject(why_not, fmt::format("{}: truncated ({} bytes for {} vertices of {} bands)", file.string(),
-                                       data.size(), vertices, bands));
-  const size_t expected = kHeaderBytes + size_t(vertices * per_vertex) + kChecksumBytes;
-  if (data.size() != expected)
-    return reject(why_not, fmt::format("{}: {} bytes where {} were expected (trailing data)", file.string(),
-                                       data.size(), expected));
-  const uint64_t stored = get_u64(data, expected - kChecksumBytes);
-  const uint64_t actual = XXH3_64bits(data.data(), expected - kChecksumBytes);
+  if (vertices > (size - kHeaderBytes - kChecksumBytes) / per_vertex)
+    return reject(why_not, fmt::format("{}: truncated ({} bytes for {} vertices of {} bands)", file.string(), size,
+                                       vertices, bands));
+  const uint64_t expected_size = kHeaderBytes + vertices * per_vertex + kChecksumBytes;  // <= size: no overflow
+  if (size != expected_size)
+    return reject(why_not, fmt::format("{}: {} bytes where {} were expected (trailing data)", file.string(), size,
+                                       expected_size));
+  data.resize(size_t(size));
+  if (!read_exactly(fd, data.data() + kHeaderBytes, data.size() - kHeaderBytes))
+    return reject(why_not, fmt::format("{}: read error or the file shrank while being read", file.string()));
+  const uint64_t stored = get_u64(data, size_t(size) - kChecksumBytes);
+  const uint64_t actual = XXH3_64bits(data.data(), size_t(size) - kChecksumBytes);
   if (stored != actual)
     return reject(why_not, fmt::format("{}: corrupt (checksum {:016x}, the data hashes to {:016x})", file.string(),
                                        stored, actual));
@@ -184,12 +217,23 @@ std::optional<PrtTransfer> read_prt_cache(const fs::path& file, const std::strin
                   : kind == 1 ? TransferKind::Shadowed
                               : TransferKind::Interreflected;
   transfer.bands = int(bands);
-  transfer.samples_per_axis = int(samples);
+  transfer.samples_per_axis = int(std::min<uint32_t>(samples, uint32_t(std::numeric_limits<int>::max())));
   transfer.coefficients.resize(size_t(vertices) * bands * bands);
   for (size_t i = 0; i < transfer.coefficients.size(); ++i)
     transfer.coefficients[i] = std::bit_cast<float>(get_u32(data, kHeaderBytes + 4 * i));
   if (why_not) why_not->clear();
   return transfer;
+}
+
+}  // namespace
+
+std::optional<PrtTransfer> read_prt_cache(const fs::path& file, const std::string& key, std::string* why_not,
+                                          std::optional<PrtCacheShape> expected) {
+  try {
+    return read_checked_prt_cache(file, key, why_not, expected);
+  } catch (const std::exception& e) {  // out of memory for a large, plausible file: still only a miss
+    return reject(why_not, fmt::format("{}: cannot read: {}", file.string(), e.what()));
+  }
 }
 
 void write_prt_cache(const fs::path& file, const std::string& key, const PrtTransfer& transfer) {
@@ -202,6 +246,10 @@ void write_prt_cache(const fs::path& file, const std::string& key, const PrtTran
   put_u32(data, uint32_t(transfer.bands));
   put_u64(data, transfer.vertex_count());
   put_u32(data, uint32_t(std::max(0, transfer.samples_per_axis)));
+  if (uint64_t(transfer.coefficients.size()) > (kMaxPrtCacheBytes - kHeaderBytes - kChecksumBytes) / 4)
+    throw std::runtime_error(fmt::format("PRT cache {}: {} coefficients would make the file larger than the limit "
+                                         "of {} bytes",
+                                         file.string(), transfer.coefficients.size(), kMaxPrtCacheBytes));
   data.reserve(data.size() + 4 * transfer.coefficients.size() + kChecksumBytes);
   for (float c : transfer.coefficients) put_u32(data, std::bit_cast<uint32_t>(c));
   put_u64(data, XXH3_64bits(data.data(), data.size()));
@@ -266,7 +314,8 @@ PrtLoad load_or_bake_prt(const Mesh& mesh, const PrtBakeSettings& settings, cons
   const std::string key = prt_cache_key(mesh, settings);
   load.file = prt_cache_file(cache_dir, key);
   std::string why_not;
-  if (std::optional<PrtTransfer> cached = read_prt_cache(load.file, key, &why_not)) {
+  if (std::optional<PrtTransfer> cached =
+          read_prt_cache(load.file, key, &why_not, PrtCacheShape{mesh.vertex_count(), settings.bands})) {
     // A key collision is beyond unlikely, but a transfer that does not fit the mesh is never used.
     if (cached->vertex_count() == mesh.vertex_count() && cached->bands == settings.bands &&
         cached->kind == settings.kind && (mesh.vertex_count() > 0 || cached->coefficients.empty())) {

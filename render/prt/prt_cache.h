@@ -36,15 +36,29 @@ std::string prt_cache_key(const Mesh& mesh, const PrtBakeSettings& settings);
 // cache_dir / (key + ".prt").
 std::filesystem::path prt_cache_file(const std::filesystem::path& cache_dir, const std::string& key);
 
+// The largest cache file read or written (2 GiB): a bigger transfer is baked but not cached.
+inline constexpr uint64_t kMaxPrtCacheBytes = uint64_t{2} << 30;
+
+// What the caller expects a cache file to hold: its mesh's vertex count and the bake's bands.
+struct PrtCacheShape {
+  uint64_t vertices = 0;
+  int bands = 0;
+};
+
 // The transfer stored in `file` for `key`; nullopt (with the reason in *why_not) when the file is
-// missing or unreadable, truncated, corrupt (checksum), of another format version or another key.
-// Never throws for a bad file.
+// missing or unreadable, not a regular file (a FIFO or device is never opened for blocking reads),
+// over kMaxPrtCacheBytes, truncated, corrupt (checksum), of another format version or another key,
+// or (given `expected`) of another shape. The file is untrusted: its header is checked against the
+// file's size (overflow-checked) before the body is read, so nothing larger than the file, and with
+// `expected` nothing larger than the expected transfer, is allocated. Never throws for a bad file.
 std::optional<PrtTransfer> read_prt_cache(const std::filesystem::path& file, const std::string& key,
-                                          std::string* why_not = nullptr);
+                                          std::string* why_not = nullptr,
+                                          std::optional<PrtCacheShape> expected = std::nullopt);
 
 // Writes atomically: the parent directories are created, the data goes to a temporary file in the
 // same directory, which is then renamed over `file`, so a crash never leaves a partial file under
-// the final name. Throws std::runtime_error naming the path on I/O failure (no temp file is left).
+// the final name. Throws std::runtime_error naming the path on I/O failure (no temp file is left)
+// or when the file would be larger than kMaxPrtCacheBytes.
 void write_prt_cache(const std::filesystem::path& file, const std::string& key, const PrtTransfer& transfer);
 
 // $XDG_CACHE_HOME/arpipe/prt, else $HOME/.cache/arpipe/prt, else an empty path (no cache).
