@@ -22,6 +22,9 @@ json parse_object(const std::string& text, const std::string& where, const char*
     // e.byte counts from 1 at the character that broke the parse.
     throw RecordingError(fmt::format("{}: invalid JSON at byte {}{} ({} expected): {}", where, e.byte,
                                      in_line ? " of the line" : "", what, e.what()));
+  } catch (const json::exception& e) {
+    // out_of_range 406: a number such as 5e308 that no double holds.
+    throw RecordingError(fmt::format("{}: invalid JSON ({} expected): {}", where, what, e.what()));
   }
   if (!value.is_object()) throw RecordingError(fmt::format("{}: expected a JSON object ({})", where, what));
   return value;

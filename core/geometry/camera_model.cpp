@@ -41,11 +41,30 @@ std::string supported_lensmodels() {
   return names;
 }
 
+// mrcal asserts (aborts the process) on spline configurations it cannot use, and counts parameters
+// in int: check them first. Order 2 needs at least 3 knots each way, order 3 at least 4; 100000
+// knots is far beyond any calibrated lens (60 x 40 is already fine-grained).
+void check_spline_config(const std::string& name, const mrcal_lensmodel_t& lensmodel) {
+  const auto& c = lensmodel.LENSMODEL_SPLINED_STEREOGRAPHIC__config;
+  constexpr int kMaxKnots = 100000;
+  if (c.order != 2 && c.order != 3)
+    throw CameraModelError(fmt::format("lens model '{}': spline order {}, expected 2 or 3", name, c.order));
+  if (c.Nx < c.order + 1 || c.Ny < c.order + 1)
+    throw CameraModelError(fmt::format("lens model '{}': order-{} splines need Nx and Ny of at least {}, got Nx={} Ny={}",
+                                       name, c.order, c.order + 1, c.Nx, c.Ny));
+  if (int{c.Nx} * int{c.Ny} > kMaxKnots)
+    throw CameraModelError(fmt::format("lens model '{}': {} x {} knots exceeds the limit of {}", name, c.Nx, c.Ny,
+                                       kMaxKnots));
+  if (c.fov_x_deg == 0) throw CameraModelError(fmt::format("lens model '{}': fov_x_deg 0, expected > 0", name));
+}
+
 // Turns a lens-model name into mrcal's struct, or says what is wrong with the name.
 mrcal_lensmodel_t lensmodel_from_name(const std::string& name) {
   mrcal_lensmodel_t lensmodel{};
-  if (mrcal_lensmodel_from_name(&lensmodel, name.c_str()) && mrcal_lensmodel_type_is_valid(lensmodel.type))
+  if (mrcal_lensmodel_from_name(&lensmodel, name.c_str()) && mrcal_lensmodel_type_is_valid(lensmodel.type)) {
+    if (lensmodel.type == MRCAL_LENSMODEL_SPLINED_STEREOGRAPHIC) check_spline_config(name, lensmodel);
     return lensmodel;
+  }
   if (lensmodel.type == MRCAL_LENSMODEL_INVALID_BADCONFIG)
     throw CameraModelError(fmt::format(
         "lens model '{}' has a missing or malformed configuration; expected one of: {}", name,

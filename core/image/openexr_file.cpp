@@ -17,6 +17,7 @@
 #include <cstring>
 #include <exception>
 #include <fstream>
+#include <map>
 #include <string_view>
 #include <vector>
 
@@ -58,6 +59,7 @@ class ExrHeaderCheck {
     if (magic != 20000630)
       throw AssetError(fmt::format("{}: byte 0: not an OpenEXR file (magic 76 2f 31 01 expected)", name_));
     const bool multipart = (version & 0x1000) != 0;
+    tiled_flag_ = !multipart && (version & 0x200) != 0;
     for (int part = 0;; ++part) {
       const bool empty = read_header();
       if (!multipart) break;
@@ -92,13 +94,41 @@ class ExrHeaderCheck {
     }
   }
 
+  // The attributes every header must have (OpenEXR's file layout), with their types and sizes (0:
+  // any): the library fills a missing one with a default and sizes its buffers from it.
+  void check_required(const std::map<std::string, std::pair<std::string, uint32_t>>& seen) const {
+    struct Required {
+      const char* name;
+      const char* type;
+      uint32_t size;
+    };
+    static constexpr Required kRequired[] = {
+        {"channels", "chlist", 0},          {"compression", "compression", 1}, {"dataWindow", "box2i", 16},
+        {"displayWindow", "box2i", 16},     {"lineOrder", "lineOrder", 1},     {"pixelAspectRatio", "float", 4},
+        {"screenWindowCenter", "v2f", 8},   {"screenWindowWidth", "float", 4}};
+    const auto check = [&](const Required& r) {
+      const auto found = seen.find(r.name);
+      if (found == seen.end()) fail(fmt::format("the required attribute \"{}\" ({}) is missing", r.name, r.type));
+      if (found->second.first != r.type || (r.size != 0 && found->second.second != r.size))
+        fail(fmt::format("attribute \"{}\" is a {} of {} bytes, expected a {}{}", r.name, found->second.first,
+                         found->second.second, r.type, r.size != 0 ? fmt::format(" of {} bytes", r.size) : ""));
+    };
+    for (const Required& r : kRequired) check(r);
+    if (tiled_flag_) check({"tiles", "tiledesc", 9});
+  }
+
   // Returns true for an empty header (the end of a multi-part file's header list).
   bool read_header() {
+    std::map<std::string, std::pair<std::string, uint32_t>> seen;  // name -> type, size
     for (int attributes = 0;; ++attributes) {
       const std::string attribute = read_name("an attribute name");
-      if (attribute.empty()) return attributes == 0;
+      if (attribute.empty()) {
+        if (attributes > 0) check_required(seen);
+        return attributes == 0;
+      }
       const std::string type = read_name("an attribute type");
       const uint32_t size = read_u32("an attribute size");
+      seen[attribute] = {type, size};
       if (size > size_ - position_)
         fail(fmt::format("attribute \"{}\" declares {} bytes, but only {} follow", attribute, size, size_ - position_));
       std::vector<char> value(size);
@@ -123,6 +153,7 @@ class ExrHeaderCheck {
           at += 1 + 16;                                      // its terminator, type, pLinear, reserved, sampling
         }
         if (channels > 64) fail(fmt::format("{} channels (a light probe needs a handful; at most 64)", channels));
+        if (channels == 0) fail("no channels (an image needs at least one)");
       }
       if (attributes > 10000) fail("more than 10000 attributes");
     }
@@ -131,6 +162,7 @@ class ExrHeaderCheck {
   std::ifstream in_;
   const std::string& name_;
   uint64_t size_ = 0, position_ = 0;
+  bool tiled_flag_ = false;  // single-part tiled file (version flag 0x200): its header needs "tiles"
 };
 
 void append_band(HdrImage& image, int rows) {

@@ -116,6 +116,17 @@ TEST_F(RecordingLimits, TimestampsThatOverflowAreRefusedWithTheLine) {
   EXPECT_TRUE(contains(message, "overflows 64-bit nanoseconds")) << message;
 }
 
+TEST_F(RecordingLimits, ANumberNoDoubleHoldsIsARecordingError) {
+  // tests/fuzz/regressions/fuzz_recording/info-number-overflow-5e308: nlohmann's out_of_range
+  // escaped as an exception that was not a RecordingError.
+  write_file(dir_ / "recording.json", "5e308");
+  const std::string message = open_error();
+  EXPECT_TRUE(contains(message, (dir_ / "recording.json").string() + ": invalid JSON (the recording description "
+                                                                     "expected): "))
+      << message;
+  EXPECT_TRUE(contains(message, "number overflow")) << message;
+}
+
 TEST_F(RecordingLimits, ReplayNamesAnEmptySourcePath) {
   SourceConfig config;
   config.pacing = "fast";

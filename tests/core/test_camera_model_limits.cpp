@@ -40,6 +40,25 @@ TEST(CameraModelLimits, DeepNestingIsRefusedAtTheLimit) {
             "");
 }
 
+TEST(CameraModelLimits, SplineConfigurationsMrcalAssertsOnAreRefused) {
+  // tests/fuzz/regressions/fuzz_cameramodel/splined-ny3-mrcal-assert.cameramodel: mrcal aborted the
+  // process ("Cubic splines: absolute minimum Nx, Ny is 4").
+  const fs::path file = fs::path(ARPIPE_SOURCE_DIR) / "tests" / "fuzz" / "regressions" / "fuzz_cameramodel" /
+                        "splined-ny3-mrcal-assert.cameramodel";
+  try {
+    CameraModel::load(file);
+    ADD_FAILURE() << "expected a CameraModelError";
+  } catch (const CameraModelError& e) {
+    EXPECT_TRUE(contains(e.what(), "order-3 splines need Nx and Ny of at least 4, got Nx=4 Ny=3")) << e.what();
+  }
+  try {
+    CameraModel("LENSMODEL_SPLINED_STEREOGRAPHIC_order=2_Nx=2_Ny=9_fov_x_deg=100", {}, 10, 10);
+    ADD_FAILURE() << "expected a CameraModelError";
+  } catch (const CameraModelError& e) {
+    EXPECT_TRUE(contains(e.what(), "order-2 splines need Nx and Ny of at least 3, got Nx=2 Ny=9")) << e.what();
+  }
+}
+
 TEST(CameraModelLimits, FilesAreRegularAndBounded) {
   const fs::path dir = fs::temp_directory_path() / ("arpipe_cameramodel_limits_" + std::to_string(::getpid()));
   fs::remove_all(dir);
