@@ -7,7 +7,7 @@
 namespace arpipe {
 
 // Throws ConfigError "<config>: <key>: <path>: <reason>" for the first input that cannot be used:
-// source.path (replay: a directory holding recording.json), source.camera_model, every
+// source.path (replay, when set: a directory holding recording.json), source.camera_model, every
 // render.objects[i].mesh that is a file (render enabled), light.environment.file (when the light
 // source is "environment" or a file is named). Paths are relative to the working directory, as
 // arpiped reads them. Only existence and type are checked here; each loader checks the content.

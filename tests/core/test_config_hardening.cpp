@@ -120,6 +120,8 @@ TEST_F(ConfigFiles, EveryNamedInputMustExistAndBeARegularFile) {
             "c.toml: source.path: " + (dir_ / "nothing").string() + ": no such directory, expected a recording directory");
   EXPECT_EQ(files_error(source() + "[light]\nsource = \"environment\"\n[light.environment]\nfile = \"/dev/zero\"\n"),
             "c.toml: light.environment.file: /dev/zero: it is a character device, expected a regular file");
+  // The defaults name no recording: nothing to check (starting the replay says source.path is empty).
+  EXPECT_EQ(files_error(""), "");
   // A disabled renderer loads no meshes.
   EXPECT_EQ(files_error(source() + "[render]\nenabled = false\n[[render.objects]]\nmesh = \"absent.gltf\"\n"), "");
 }
