@@ -75,7 +75,8 @@ bool read_external_file(std::vector<unsigned char>* out, std::string* err, const
                         void* user_data) {
   ExternalFiles& files = *static_cast<ExternalFiles*>(user_data);
   // tinygltf joins the folder, "/" and the decoded URI; resolve what follows the folder.
-  const std::string prefix = files.folder.string() + "/";
+  std::string prefix = files.folder.string();
+  if (prefix.empty() || prefix.back() != '/') prefix += '/';  // as tinygltf's JoinPath (the root folder ends in '/')
   std::string why;
   if (joined_path.compare(0, prefix.size(), prefix) != 0) {
     if (err) *err = "not inside the glTF file's folder";
