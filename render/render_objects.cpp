@@ -7,8 +7,10 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <stdexcept>
 
 #include "core/log.h"
+#include "core/scene/asset_error.h"
 #include "core/scene/builtin_meshes.h"
 #include "core/scene/gltf_loader.h"
 #include "render/prt/prt_cache.h"
@@ -16,15 +18,25 @@
 namespace arpipe {
 namespace {
 
+std::string config_name(const Config& config) {
+  return config.file.empty() ? std::string("config") : config.file.string();
+}
+
+// Errors name the config key as well as the file (the message from the loader names the file and
+// the place in it).
 Mesh load_mesh(const Config& config, size_t object_index, const std::string& source) {
   if (is_builtin_mesh_source(source)) {
     if (auto mesh = make_builtin_mesh(source)) return std::move(*mesh);
     throw ConfigError(fmt::format("{}: render.objects[{}].mesh: unknown builtin mesh \"{}\" (expected "
                                   "{} or a glTF 2.0 file)",
-                                  config.file.empty() ? std::string("config") : config.file.string(), object_index,
-                                  source, kBuiltinMeshNames));
+                                  config_name(config), object_index, source, kBuiltinMeshNames));
   }
-  return load_gltf_mesh(source);  // relative to the working directory, like every path in a config
+  try {
+    return load_gltf_mesh(source);  // relative to the working directory, like every path in a config
+  } catch (const std::exception& e) {
+    throw AssetError(fmt::format("{}: render.objects[{}].mesh = \"{}\": {}", config_name(config), object_index,
+                                 source, e.what()));
+  }
 }
 
 Bounds scaled(const Bounds& box, double scale) {
@@ -39,8 +51,8 @@ Bounds scaled(const Bounds& box, double scale) {
 
 // The first 3 bands of the object's baked transfer (from the cache, else baked now and cached),
 // or nothing for prt = "off".
-std::vector<float> transfer_for(const Config& config, const std::string& mesh_source, const Mesh& mesh,
-                                const std::string& prt) {
+std::vector<float> transfer_for(const Config& config, size_t object_index, const std::string& mesh_source,
+                                const Mesh& mesh, const std::string& prt) {
   const std::optional<TransferKind> kind = parse_transfer_kind(prt);
   if (!kind || mesh.vertex_count() == 0) return {};
   PrtBakeSettings settings;
@@ -50,7 +62,13 @@ std::vector<float> transfer_for(const Config& config, const std::string& mesh_so
   const std::filesystem::path cache_dir =
       config.render.prt.cache_dir.empty() ? default_prt_cache_dir() : config.render.prt.cache_dir;
   const auto start = std::chrono::steady_clock::now();
-  const PrtLoad load = load_or_bake_prt(mesh, settings, cache_dir);
+  PrtLoad load;
+  try {
+    load = load_or_bake_prt(mesh, settings, cache_dir);
+  } catch (const std::exception& e) {
+    throw AssetError(fmt::format("{}: render.objects[{}] (mesh \"{}\", prt = \"{}\"): {}", config_name(config),
+                                 object_index, mesh_source, prt, e.what()));
+  }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   // Baking is expected once per mesh (info); a transfer that could not be cached is baked again at
   // every start (a warning).
@@ -69,28 +87,42 @@ std::vector<float> transfer_for(const Config& config, const std::string& mesh_so
 
 }  // namespace
 
-std::vector<RenderObject> load_render_objects(const Config& config) {
-  struct Loaded {
-    std::shared_ptr<const GpuMesh> gpu;
-    Bounds bounds;
-  };
-  std::map<std::string, Loaded> loaded;
-  std::vector<RenderObject> objects;
+RenderMeshes load_render_meshes(const Config& config) {
+  RenderMeshes loaded;
+  std::map<std::string, size_t> index_of;  // mesh source and prt mode -> loaded.meshes
   for (size_t i = 0; i < config.render.objects.size(); ++i) {
     const SceneObject& object = config.render.objects[i];
     const std::string key = object.mesh + "\n" + object.prt;
-    auto found = loaded.find(key);
-    if (found == loaded.end()) {
-      const Mesh mesh = load_mesh(config, i, object.mesh);
-      const std::vector<float> transfer = transfer_for(config, object.mesh, mesh, object.prt);
-      found = loaded.emplace(key, Loaded{std::make_shared<const GpuMesh>(mesh, transfer), mesh.bounds()}).first;
+    auto found = index_of.find(key);
+    if (found == index_of.end()) {
+      RenderMeshes::Entry entry;
+      entry.mesh = load_mesh(config, i, object.mesh);
+      entry.transfer = transfer_for(config, i, object.mesh, entry.mesh, object.prt);
+      loaded.meshes.push_back(std::move(entry));
+      found = index_of.emplace(key, loaded.meshes.size() - 1).first;
     }
+    loaded.mesh_of_object.push_back(found->second);
+  }
+  return loaded;
+}
+
+std::vector<RenderObject> upload_render_objects(const Config& config, const RenderMeshes& loaded) {
+  if (loaded.mesh_of_object.size() != config.render.objects.size())
+    throw std::logic_error(fmt::format("upload_render_objects: {} objects loaded for a config with {}",
+                                       loaded.mesh_of_object.size(), config.render.objects.size()));
+  std::vector<std::shared_ptr<const GpuMesh>> uploaded;
+  for (const RenderMeshes::Entry& entry : loaded.meshes)
+    uploaded.push_back(std::make_shared<const GpuMesh>(entry.mesh, entry.transfer));
+  std::vector<RenderObject> objects;
+  for (size_t i = 0; i < config.render.objects.size(); ++i) {
+    const SceneObject& object = config.render.objects[i];
+    const size_t m = loaded.mesh_of_object[i];
     RenderObject out;
     out.mesh_source = object.mesh;
-    out.mesh = found->second.gpu;
+    out.mesh = uploaded[m];
     out.scale = object.scale;
     out.specular = object.specular;
-    out.bounds = scaled(found->second.bounds, object.scale);
+    out.bounds = scaled(loaded.meshes[m].mesh.bounds(), object.scale);
     out.T_world_object = SE3::from_rt({0, 0, object.yaw_rad}, object.position_m);
     if (is_builtin_mesh_source(object.mesh))
       out.base_color = std::array<float, 4>{static_cast<float>(object.color[0]), static_cast<float>(object.color[1]),
@@ -98,6 +130,10 @@ std::vector<RenderObject> load_render_objects(const Config& config) {
     objects.push_back(std::move(out));
   }
   return objects;
+}
+
+std::vector<RenderObject> load_render_objects(const Config& config) {
+  return upload_render_objects(config, load_render_meshes(config));
 }
 
 }  // namespace arpipe

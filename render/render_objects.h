@@ -29,8 +29,25 @@ struct RenderObject {
 };
 
 
-// Loads every render.objects entry; needs a current GL context. Each distinct mesh is read once.
-// Throws ConfigError for an unknown "builtin:" name and AssetError for a missing or bad file.
+// The meshes of render.objects read (and their PRT transfer baked or taken from the cache) on the
+// CPU, without GL, so a reload can do it away from the processing thread. Each distinct mesh and
+// prt mode is loaded once. Throws ConfigError for an unknown "builtin:" name and AssetError for a
+// missing or bad file or a failed bake, naming the config key (render.objects[i].mesh) and the file.
+struct RenderMeshes {
+  struct Entry {
+    Mesh mesh;
+    std::vector<float> transfer;  // 9 coefficients per vertex, or empty without PRT
+  };
+  std::vector<Entry> meshes;
+  std::vector<size_t> mesh_of_object;  // per render.objects entry: its index in meshes
+};
+RenderMeshes load_render_meshes(const Config& config);
+
+// Uploads what load_render_meshes made of this same config and places the objects; needs a current
+// GL context.
+std::vector<RenderObject> upload_render_objects(const Config& config, const RenderMeshes& loaded);
+
+// Both of the above, on the calling thread.
 std::vector<RenderObject> load_render_objects(const Config& config);
 
 }  // namespace arpipe

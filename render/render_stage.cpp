@@ -10,6 +10,7 @@
 #include <cmath>
 #include <numbers>
 #include <optional>
+#include <stdexcept>
 
 #include "core/light/sh9.h"
 #include "core/log.h"
@@ -34,6 +35,12 @@ constexpr double kShadowLightStepRad = 0.05 * kRadiansPerDegree;
 // ambient irradiance / pi from the radiance's coefficients, band by band.
 constexpr double kIrradianceOverPi[3] = {1.0, 2.0 / 3.0, 0.25};
 
+// What the render stage's loader reads away from the processing thread: the objects' meshes and
+// their PRT transfers, on the CPU.
+struct RenderAssets final : StageAssets {
+  RenderMeshes meshes;
+};
+
 }  // namespace
 
 RenderStage::RenderStage(std::shared_ptr<RenderSession> session) : session_(std::move(session)) {}
@@ -47,12 +54,24 @@ RenderStage::~RenderStage() {
   drawer_.reset();
 }
 
-void RenderStage::configure(const Config& config) {
+StageAssetLoader RenderStage::asset_loader() const {
+  return [](const Config& config) -> std::shared_ptr<const StageAssets> {
+    auto assets = std::make_shared<RenderAssets>();
+    assets->meshes = load_render_meshes(config);
+    return assets;
+  };
+}
+
+void RenderStage::configure(const Config& config) { configure_loaded(config, asset_loader()(config)); }
+
+void RenderStage::configure_loaded(const Config& config, const std::shared_ptr<const StageAssets>& assets) {
+  const auto* loaded = dynamic_cast<const RenderAssets*>(assets.get());
+  if (!loaded) throw std::logic_error("RenderStage::configure_loaded: no assets from the render stage's loader");
   session_->ensure_context(config.render.egl_platform);
   session_->make_current();
   if (!drawer_) drawer_ = std::make_unique<MotionBlurDrawer>(session_->context(), session_->layer().color_format());
   drawer_->prepare(parse_blur_method(config.render.blur.method));
-  std::vector<RenderObject> objects = load_render_objects(config);
+  std::vector<RenderObject> objects = upload_render_objects(config, loaded->meshes);
 
   Settings settings;
   settings.enabled = config.render.enabled;

@@ -28,7 +28,12 @@ class RenderStage final : public Stage {
   std::string_view name() const override { return "render"; }
   // Creates the GL context on the first call (on this thread), compiles the shaders once, and
   // loads the meshes; throws RenderError, ConfigError or AssetError and then keeps the old setup.
+  // configure_loaded() does the same with meshes already loaded by asset_loader() (reading the
+  // meshes and baking their PRT transfers happen there, off the processing thread); only the GPU
+  // upload is left for the processing thread.
   void configure(const Config& config) override;
+  StageAssetLoader asset_loader() const override;
+  void configure_loaded(const Config& config, const std::shared_ptr<const StageAssets>& assets) override;
   // With render.lens = "map", builds the camera model's warp map (mrcal, a few hundred ms at
   // 640x480) before streaming starts; "undistort": its pinhole core. A frame with another model
   // builds its own on its first drawn frame.

@@ -1,4 +1,5 @@
 // arpipe: the utility beside the daemon: inspect and replay recordings, simulate captures, check configs.
+#include <csignal>
 #include <cstdio>
 #include <string>
 
@@ -54,6 +55,7 @@ commands:
 int main(int argc, char** argv) {
   arpipe::keep_frame_memory_resident();
   arpipe::log::set_program_name("arpipe");
+  std::signal(SIGPIPE, SIG_IGN);  // a reader that goes away (a FIFO output) is EPIPE for the sink, not death
   if (argc < 2 || std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h") {
     std::fputs(kUsage, argc < 2 ? stderr : stdout);
     return argc < 2 ? 2 : 0;

@@ -15,7 +15,8 @@ Runs the arpipe pipeline described by FILE (TOML, default /etc/arpipe/arpipe.tom
   --config FILE      the config file; relative paths inside it are relative to the working directory
   --set KEY=VALUE    overrides one config key (VALUE in TOML syntax, e.g. --set pipeline.max_frames=10)
   --help             this text
-Signals: SIGTERM/SIGINT drain the queues and flush the outputs; SIGHUP reloads the config file.
+Signals: SIGTERM/SIGINT drain the queues and flush the outputs (during setup: exit at once);
+  SIGHUP reloads the config file in the background (the running config stays until it is loaded).
 Exit status: 0 when the stream ended or the daemon was stopped, 2 on a setup error.
 )";
 

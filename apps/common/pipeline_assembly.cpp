@@ -78,8 +78,12 @@ std::unique_ptr<PipelineRunner> assemble_pipeline(const Config& config) {
         "outlast its frame",
         config.file.empty() ? std::string("the config") : config.file.string(), double(config.motion.default_exposure_ns) * 1e-6,
         source->describe(), double(*interval) * 1e-6));
-  auto sinks = make_sinks(config);
-  return std::make_unique<PipelineRunner>(std::move(source), make_stage_factory(config), std::move(sinks), config);
+  // The outputs are opened by start() once the stages are configured: a setup that fails (a bad
+  // mesh) or is stopped before then leaves the previous run's outputs as they were.
+  auto runner = std::make_unique<PipelineRunner>(std::move(source), make_stage_factory(config),
+                                                 std::vector<std::unique_ptr<FrameSink>>{}, config);
+  runner->make_sinks_at_start([config] { return make_sinks(config); });
+  return runner;
 }
 
 std::string describe_metrics(const PipelineMetrics& m) {

@@ -14,7 +14,7 @@ std::vector<std::unique_ptr<FrameSink>> make_sinks(const Config& config);
 // track, motion (when tracking and motion are enabled), render, composite (in that order), created
 // on the processing thread. The default config has both on.
 StageFactory make_stage_factory(const Config& config = Config{});
-// All of the above in a runner (not started).
+// All of the above in a runner (not started); the sinks are made by its start(), after the stages.
 std::unique_ptr<PipelineRunner> assemble_pipeline(const Config& config);
 
 // Human-readable one-paragraph summary of what a finished run did, for logs and the CLI.

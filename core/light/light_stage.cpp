@@ -4,6 +4,9 @@
 #include <fmt/format.h>
 #include <time.h>
 
+#include <optional>
+#include <stdexcept>
+
 #include "core/light/environment_light.h"
 #include "core/log.h"
 #include "core/pipeline/monotonic_clock.h"
@@ -18,9 +21,26 @@ int64_t realtime_minus_monotonic_ns() {
   return (int64_t(real.tv_sec) - int64_t(mono.tv_sec)) * 1'000'000'000 + (int64_t(real.tv_nsec) - int64_t(mono.tv_nsec));
 }
 
+// The environment's light as the loader read it (light.source = "environment"), else nothing.
+struct EnvironmentAssets final : StageAssets {
+  std::optional<LightEstimate> environment;
+};
+
 }  // namespace
 
-void LightStage::configure(const Config& config) {
+StageAssetLoader LightStage::asset_loader() const {
+  return [](const Config& config) -> std::shared_ptr<const StageAssets> {
+    auto assets = std::make_shared<EnvironmentAssets>();
+    if (config.light.source == "environment") assets->environment = load_environment_lighting(config).estimate;
+    return assets;
+  };
+}
+
+void LightStage::configure(const Config& config) { configure_loaded(config, asset_loader()(config)); }
+
+void LightStage::configure_loaded(const Config& config, const std::shared_ptr<const StageAssets>& assets) {
+  const auto* loaded = dynamic_cast<const EnvironmentAssets*>(assets.get());
+  if (!loaded) throw std::logic_error("LightStage::configure_loaded: no assets from the light stage's loader");
   const LightConfig& light = config.light;
   CameraResponse response;
   try {
@@ -56,7 +76,8 @@ void LightStage::configure(const Config& config) {
     sun->configure(light.sun, light.ground_albedo, response, light.smoothing_s, config.file);
   } else if (light.source == "environment") {
     source = Source::Environment;
-    environment = load_environment_lighting(config).estimate;
+    if (!loaded->environment) throw std::logic_error("LightStage::configure_loaded: the environment was not loaded");
+    environment = *loaded->environment;
     log::info("light: environment {} ({}), ambient L00 = ({:.4g}, {:.4g}, {:.4g})", light.environment.file.string(),
               light.environment.layout, environment.ambient_sh[0][0], environment.ambient_sh[0][1],
               environment.ambient_sh[0][2]);

@@ -20,6 +20,10 @@ class LightStage final : public Stage {
   // Throws ConfigError naming the key on a probe or sun setting that cannot work; the old setup
   // then stays.
   void configure(const Config& config) override;
+  // light.source = "environment": the HDR file is read and projected by the loader, off the
+  // processing thread on a reload; configure_loaded() only takes the result.
+  StageAssetLoader asset_loader() const override;
+  void configure_loaded(const Config& config, const std::shared_ptr<const StageAssets>& assets) override;
   // Fixed: records the skip and leaves ctx.light for the renderer's fixed light. Probe and sun:
   // the estimate, Held or None with a note when this frame could not be measured.
   void process(FrameContext& ctx) noexcept override;

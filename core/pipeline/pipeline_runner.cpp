@@ -1,5 +1,7 @@
 #include "core/pipeline/pipeline_runner.h"
 
+#include <fmt/format.h>
+
 #include <chrono>
 #include <deque>
 #include <exception>
@@ -9,11 +11,6 @@
 #include "core/pipeline/monotonic_clock.h"
 
 namespace arpipe {
-
-struct PipelineRunner::PendingReconfigure {
-  Config config;
-  std::promise<std::string> result;  // empty string = accepted
-};
 
 PipelineRunner::PipelineRunner(std::unique_ptr<FrameSource> source, StageFactory stages,
                                std::vector<std::unique_ptr<FrameSink>> sinks, const Config& config)
@@ -38,10 +35,18 @@ void PipelineRunner::start() {
   processing_thread_ = std::thread([this, &configured] {
     try {
       stages_ = stage_factory_();
-      for (auto& stage : stages_) stage->configure(config_);
+      std::vector<std::pair<std::string, StageAssetLoader>> loaders;
+      for (auto& stage : stages_) {
+        StageAssetLoader loader = stage->asset_loader();
+        running_assets_.push_back(loader ? loader(config_) : nullptr);
+        stage->configure_loaded(config_, running_assets_.back());
+        loaders.emplace_back(std::string(stage->name()), std::move(loader));
+      }
       for (auto& stage : stages_) stage->prepare(source_->camera_model());
+      reloader_ = std::make_shared<StageReloader>(std::move(loaders));
     } catch (...) {
       stages_.clear();
+      running_assets_.clear();
       configured.set_exception(std::current_exception());
       return;
     }
@@ -53,6 +58,16 @@ void PipelineRunner::start() {
   } catch (...) {
     processing_thread_.join();
     throw;
+  }
+  // The outputs are opened last, once nothing slow or refusable is left before the first frame.
+  if (sink_factory_) {
+    try {
+      for (auto& sink : sink_factory_()) sinks_.push_back(std::move(sink));
+    } catch (...) {
+      to_process_->close();  // the processing thread ends, destroying the stages on its own thread
+      processing_thread_.join();
+      throw;
+    }
   }
   sink_thread_ = std::thread([this] { sink_loop(); });
   capture_thread_ = std::thread([this] { capture_loop(); });
@@ -159,15 +174,15 @@ void PipelineRunner::processing_loop() {
   }
   finish_held(0);  // the end of the stream: the last frames go on without a look-ahead
   to_sink_->close();
-  {
-    std::lock_guard lock(reconfigure_mutex_);
-    processing_ended_ = true;  // later reloads are answered at once
-  }
-  apply_pending_reconfigure();  // answer a reload that raced with the end of the stream
-  stages_.clear();              // destroys the GL context on the thread that made it
+  reloader_->close("the stream has ended; nothing left to reconfigure");
+  stages_.clear();  // destroys the GL context on the thread that made it
+  running_assets_.clear();
 }
 
 void PipelineRunner::sink_loop() {
+  // On the sink thread, so it never races consume(): the stages are configured and every sink
+  // exists, so the outputs of an earlier run may now be replaced.
+  for (auto& sink : sinks_) sink->run_started();
   while (auto ctx = to_sink_->pop()) {
     sink_busy_since_ns_ = monotonic_now_ns();
     for (auto& sink : sinks_) sink->consume(*ctx);
@@ -180,59 +195,43 @@ void PipelineRunner::sink_loop() {
   finished_ = true;
 }
 
-bool PipelineRunner::reconfigure(const Config& config, std::string& error) {
-  auto request = std::make_shared<PendingReconfigure>();
-  request->config = config;
-  auto answer = request->result.get_future();
-  {
-    std::lock_guard lock(reconfigure_mutex_);
-    if (processing_ended_) {
-      error = "the stream has ended; nothing left to reconfigure";
-      return false;
-    }
-    pending_reconfigure_ = request;
-  }
-  // The processing thread picks it up before its next frame.
-  if (answer.wait_for(std::chrono::seconds(10)) != std::future_status::ready) {
-    std::lock_guard lock(reconfigure_mutex_);
-    if (pending_reconfigure_ == request) pending_reconfigure_.reset();
-    error = "the pipeline did not reach a frame boundary within 10 s (no frames arriving?)";
+bool PipelineRunner::reconfigure(const Config& config, std::string& error,
+                                 std::chrono::milliseconds boundary_timeout) {
+  if (!reloader_) {
+    error = "the pipeline has not started";
     return false;
   }
-  error = answer.get();
-  return error.empty();
+  return reloader_->reconfigure(reloader_->new_ticket(), config, error, boundary_timeout);
 }
 
 void PipelineRunner::apply_pending_reconfigure() {
-  std::shared_ptr<PendingReconfigure> request;
-  {
-    std::lock_guard lock(reconfigure_mutex_);
-    request.swap(pending_reconfigure_);
-  }
+  const std::shared_ptr<StageReloader::Request> request = reloader_->claim();
   if (!request) return;
+  const StageReloader::Loaded& next = reloader_->loaded(*request);
   std::string error;
-  for (auto& stage : stages_) {
+  for (size_t i = 0; i < stages_.size(); ++i) {
     try {
-      stage->configure(request->config);
+      stages_[i]->configure_loaded(next.config, next.assets[i]);
     } catch (const std::exception& e) {
-      error = fmt::format("stage {}: {}", stage->name(), e.what());
+      error = fmt::format("stage {}: {}", stages_[i]->name(), e.what());
       break;
     }
   }
   if (!error.empty()) {
-    // Put every stage back on the configuration that was running.
-    for (auto& stage : stages_) {
+    // Put every stage back on the configuration that was running, with the assets it was loaded into.
+    for (size_t i = 0; i < stages_.size(); ++i) {
       try {
-        stage->configure(config_);
+        stages_[i]->configure_loaded(config_, running_assets_[i]);
       } catch (const std::exception& e) {
-        log::error("stage {} could not return to the running config: {}", stage->name(), e.what());
+        log::error("stage {} could not return to the running config: {}", stages_[i]->name(), e.what());
       }
     }
   } else {
-    config_ = request->config;
+    config_ = next.config;
+    running_assets_ = next.assets;
   }
   for (auto& stage : stages_) stage->prepare(source_->camera_model());
-  request->result.set_value(error);
+  reloader_->finish(request, error);
 }
 
 PipelineMetrics PipelineRunner::metrics() const {

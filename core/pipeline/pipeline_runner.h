@@ -3,6 +3,7 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -16,11 +17,13 @@
 #include "core/pipeline/frame_source.h"
 #include "core/pipeline/pipeline_metrics.h"
 #include "core/pipeline/stage.h"
+#include "core/pipeline/stage_reloader.h"
 
 namespace arpipe {
 
 // Creates the stages on the processing thread (GL contexts are bound to the thread that made them).
 using StageFactory = std::function<std::vector<std::unique_ptr<Stage>>()>;
+using SinkFactory = std::function<std::vector<std::unique_ptr<FrameSink>>()>;
 
 class PipelineRunner {
  public:
@@ -28,7 +31,12 @@ class PipelineRunner {
                  std::vector<std::unique_ptr<FrameSink>> sinks, const Config& config);
   ~PipelineRunner();  // stops and joins
 
-  // Starts the threads; blocks until the stages are configured. Throws if configuring failed.
+  // Sinks that start() makes once every stage is configured, after those given to the constructor:
+  // a setup that fails (or is stopped) while loading its assets has not opened a single output.
+  void make_sinks_at_start(SinkFactory factory) { sink_factory_ = std::move(factory); }
+
+  // Starts the threads; blocks until the stages are configured (their assets loaded on the
+  // processing thread, which has nothing else to do yet) and the sinks made. Throws if that failed.
   void start();
   // Ends the source, lets the queues drain through every stage and sink, flushes the sinks.
   void stop();
@@ -36,8 +44,15 @@ class PipelineRunner {
   void wait();
   bool finished() const { return finished_; }
 
-  // Validated on the processing thread between frames; false (with the reason) keeps the old one.
-  bool reconfigure(const Config& config, std::string& error);
+  // A reload: the stages' assets are loaded on the calling thread, then swapped in by the processing
+  // thread at a frame boundary (StageReloader::reconfigure); false (with the reason) keeps the
+  // running config, and a refused reload is never applied later. Only after start().
+  bool reconfigure(const Config& config, std::string& error,
+                   std::chrono::milliseconds boundary_timeout = kReconfigureBoundaryTimeout);
+  // For a reload from another thread that must not keep the runner alive (it may be stuck loading).
+  // Null before start().
+  std::shared_ptr<StageReloader> reloader() const { return reloader_; }
+  static constexpr std::chrono::milliseconds kReconfigureBoundaryTimeout{10'000};
 
   PipelineMetrics metrics() const;
   std::string source_description() const { return source_->describe(); }
@@ -58,7 +73,9 @@ class PipelineRunner {
 
   std::unique_ptr<FrameSource> source_;
   StageFactory stage_factory_;
+  SinkFactory sink_factory_;
   std::vector<std::unique_ptr<Stage>> stages_;
+  std::vector<std::shared_ptr<const StageAssets>> running_assets_;  // what config_ was loaded into, per stage
   std::vector<std::unique_ptr<FrameSink>> sinks_;
   Config config_;
   std::unique_ptr<BoundedQueue<FrameContext>> to_process_;
@@ -69,11 +86,9 @@ class PipelineRunner {
   std::atomic<int64_t> busy_since_ns_{0};       // 0 while the processing thread waits for a frame
   std::atomic<int64_t> sink_busy_since_ns_{0};  // 0 while the sink thread waits for a frame
 
+  // Between frames, on the processing thread: swaps in a loaded reload, if one waits.
   void apply_pending_reconfigure();
-  struct PendingReconfigure;
-  std::mutex reconfigure_mutex_;
-  std::shared_ptr<PendingReconfigure> pending_reconfigure_;
-  bool processing_ended_ = false;  // guarded by reconfigure_mutex_
+  std::shared_ptr<StageReloader> reloader_;  // made by start() with the stages' loaders
   int64_t start_ns_ = 0;
 
   mutable std::mutex metrics_mutex_;

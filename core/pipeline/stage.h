@@ -2,6 +2,7 @@
 // process() never throws: a problem with one frame is recorded in the FrameContext.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string_view>
 
@@ -10,6 +11,13 @@
 
 namespace arpipe {
 
+// What a stage loads for one config away from the processing thread (meshes, baked transfers,
+// decoded images): opaque to the runner, which only carries it from the loader to configure_loaded().
+struct StageAssets {
+  virtual ~StageAssets() = default;
+};
+using StageAssetLoader = std::function<std::shared_ptr<const StageAssets>(const Config&)>;
+
 class Stage {
  public:
   virtual ~Stage() = default;
@@ -17,6 +25,18 @@ class Stage {
   // Called before the first frame and again on a config reload. May throw ConfigError (or any
   // std::exception) to refuse the config; the stage then keeps its previous configuration.
   virtual void configure(const Config& config) = 0;
+  // The slow part of configuring that needs no GL context: reading, decoding, baking. On a reload
+  // the runner calls the returned function on the reloading thread, never on the processing thread,
+  // so frames keep flowing while it runs; it may throw to refuse the config. It must hold no
+  // reference to the stage (a load stuck on a file may outlive it) and must not touch the running
+  // configuration. Empty (the default) when configure() has nothing slow to do.
+  virtual StageAssetLoader asset_loader() const { return {}; }
+  // configure() with what asset_loader() made of this same config (null when the stage has no
+  // loader): how the runner configures, on the processing thread. Same contract as configure().
+  virtual void configure_loaded(const Config& config, const std::shared_ptr<const StageAssets>& assets) {
+    (void)assets;
+    configure(config);
+  }
   // Called after each configure, before the next frame, with the source's camera model (null when
   // it has none): the place to build what depends on the lens (a warp map takes a few hundred ms),
   // so that the first frames do not stall. Must not throw: a lens the stage cannot use shows up on

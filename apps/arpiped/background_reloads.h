@@ -1,0 +1,36 @@
+// arpiped's SIGHUP reloads, each on a thread of its own: the main thread keeps answering signals and
+// pinging the watchdog, and the processing thread keeps drawing frames, while a config and its
+// assets load. A newer SIGHUP supersedes a reload still loading; a refused reload is never applied.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+
+#include "apps/arpiped/daemon.h"
+#include "apps/arpiped/systemd_notifier.h"
+#include "core/config/config.h"
+#include "core/pipeline/stage_reloader.h"
+
+namespace arpipe {
+
+class BackgroundReloads {
+ public:
+  // started: the config the source and queues were built from (their changes need a restart).
+  BackgroundReloads(const DaemonOptions& options, const Config& started, std::shared_ptr<StageReloader> reloader,
+                    SystemdNotifier systemd);
+
+  // Reloads the config file on a new thread (RELOADING=1 now, READY=1 once the newest reload is
+  // answered). Logs "reload accepted", "reload refused, ..." or that a newer SIGHUP superseded it.
+  void start();
+  // Whether a reload thread is still running (stuck on a file, or baking): the daemon then leaves
+  // with _exit rather than unwind what that thread may still touch.
+  bool any_running() const;
+
+ private:
+  struct Shared;  // what the (detached) reload threads share; outlives this object when one is stuck
+  // One reload, on its own thread.
+  static void reload(const std::shared_ptr<Shared>& s, uint64_t ticket);
+  std::shared_ptr<Shared> shared_;
+};
+
+}  // namespace arpipe
