@@ -75,8 +75,9 @@ OutputFile::OutputFile(const std::filesystem::path& path, std::string_view confi
     if (ec) throw fail(fmt::format("cannot follow the symbolic link: {}", ec.message()));
   }
   struct stat st {};
-  if (::stat(path_.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) throw fail("cannot open for writing: Is a directory");
-  regular_ = ::stat(path_.c_str(), &st) != 0 || S_ISREG(st.st_mode);
+  const bool exists = ::stat(path_.c_str(), &st) == 0;
+  if (exists && S_ISDIR(st.st_mode)) throw fail("cannot open for writing: Is a directory");
+  regular_ = !exists || S_ISREG(st.st_mode);
   if (regular_) {
     const std::string name = path_.filename().string();
     remove_stale_temporaries(path_.parent_path(), [&](std::string_view target) { return target == name; });
