@@ -49,7 +49,8 @@ FileAccessError::FileAccessError(const std::filesystem::path& path, std::string_
                                  std::string_view action)
     : std::runtime_error(fmt::format("{}: cannot {} {}: {}", path.string(), action, what, reason)),
       path_(path),
-      reason_(std::move(reason)) {}
+      reason_(std::move(reason)),
+      action_(action) {}
 
 int open_regular_file(const std::filesystem::path& path, std::string_view what) {
   if (path.empty()) throw FileAccessError(path, what, "the path is empty");
@@ -76,7 +77,12 @@ int open_regular_file(const std::filesystem::path& path, std::string_view what) 
 
 std::string read_regular_file(const std::filesystem::path& path, std::string_view what, uint64_t max_bytes) {
   Fd fd(open_regular_file(path, what));
+  // Refused by its size before a byte is read; the loop below still stops a file that grows.
+  struct stat st {};
+  if (::fstat(fd.get(), &st) == 0 && uint64_t(st.st_size) > max_bytes)
+    throw FileAccessError(path, what, fmt::format("it is larger than the limit of {} bytes", max_bytes));
   std::string bytes;
+  bytes.reserve(size_t(st.st_size));
   char buffer[65536];
   for (;;) {
     const ssize_t n = ::read(fd.get(), buffer, sizeof buffer);

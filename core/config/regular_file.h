@@ -21,10 +21,13 @@ class FileAccessError : public std::runtime_error {
                   std::string_view action = "read");
   const std::filesystem::path& path() const { return path_; }
   const std::string& reason() const { return reason_; }
+  // "cannot open: <reason>" or "cannot read: <reason>", for messages that name the file elsewhere.
+  std::string action_and_reason() const { return "cannot " + action_ + ": " + reason_; }
 
  private:
   std::filesystem::path path_;
   std::string reason_;
+  std::string action_;
 };
 
 // Opens `path` read-only and returns the descriptor (O_CLOEXEC; the caller closes it). Opening uses

@@ -2,82 +2,31 @@
 // asset's external references only inside the asset's own folder (symlinks resolved).
 #include "core/scene/asset_file.h"
 
-#include <fcntl.h>
+#include "core/config/regular_file.h"
+
 #include <fmt/format.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
 #include <system_error>
 
 namespace arpipe {
-namespace {
 
 namespace fs = std::filesystem;
 
-std::string errno_text(int error) { return std::error_code(error, std::generic_category()).message(); }
-
-class FileDescriptor {
- public:
-  explicit FileDescriptor(int fd) : fd_(fd) {}
-  ~FileDescriptor() {
-    if (fd_ >= 0) ::close(fd_);
-  }
-  FileDescriptor(const FileDescriptor&) = delete;
-  FileDescriptor& operator=(const FileDescriptor&) = delete;
-  int get() const { return fd_; }
-
- private:
-  int fd_;
-};
-
-const char* file_kind(mode_t mode) {
-  if (S_ISDIR(mode)) return "a directory";
-  if (S_ISFIFO(mode)) return "a FIFO";
-  if (S_ISCHR(mode) || S_ISBLK(mode)) return "a device";
-  if (S_ISSOCK(mode)) return "a socket";
-  return "not a plain file";
-}
-
-}  // namespace
-
-std::optional<std::vector<unsigned char>> read_regular_file(const fs::path& path, uint64_t limit, std::string* why) {
-  // O_NONBLOCK: opening a FIFO must not wait for a writer; fstat then refuses it.
-  const FileDescriptor fd(::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY));
-  if (fd.get() < 0) {
-    *why = fmt::format("cannot open: {}", errno_text(errno));
+std::optional<std::vector<unsigned char>> read_asset_file(const fs::path& path, uint64_t limit, std::string* why) {
+  // The one regular-file rule of the project (core/config/regular_file.h): no FIFO, device,
+  // directory, /proc or /sys, no blocking on open, reading stops at the limit.
+  try {
+    const std::string text = read_regular_file(path, "asset file", limit);
+    return std::vector<unsigned char>(text.begin(), text.end());
+  } catch (const FileAccessError& error) {
+    *why = error.action_and_reason();
+    return std::nullopt;
+  } catch (const std::bad_alloc&) {
+    *why = "out of memory while reading it";
     return std::nullopt;
   }
-  struct stat info {};
-  if (::fstat(fd.get(), &info) != 0) {
-    *why = fmt::format("cannot stat: {}", errno_text(errno));
-    return std::nullopt;
-  }
-  if (!S_ISREG(info.st_mode)) {
-    *why = fmt::format("not a regular file ({})", file_kind(info.st_mode));
-    return std::nullopt;
-  }
-  const uint64_t size = uint64_t(std::max<off_t>(info.st_size, 0));
-  if (size > limit) {
-    *why = fmt::format("{} bytes, over the limit of {} bytes", size, limit);
-    return std::nullopt;
-  }
-  std::vector<unsigned char> bytes(size);
-  for (size_t done = 0; done < bytes.size();) {
-    const ssize_t n = ::read(fd.get(), bytes.data() + done, bytes.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n < 0) {
-      *why = fmt::format("read error: {}", errno_text(errno));
-      return std::nullopt;
-    }
-    if (n == 0) {
-      *why = fmt::format("shrank to {} bytes while being read ({} expected)", done, bytes.size());
-      return std::nullopt;
-    }
-    done += size_t(n);
-  }
-  return bytes;
 }
 
 std::optional<fs::path> canonical_folder(const fs::path& file, std::string* why) {

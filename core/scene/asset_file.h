@@ -13,8 +13,8 @@ namespace arpipe {
 // The whole of `path` when it is a regular file (after symlinks) of at most `limit` bytes; else
 // nullopt with the reason in *why (no path in it: the caller names the file). A FIFO, device or
 // directory is refused without blocking, and nothing is read from a file over the limit.
-std::optional<std::vector<unsigned char>> read_regular_file(const std::filesystem::path& path, uint64_t limit,
-                                                            std::string* why);
+std::optional<std::vector<unsigned char>> read_asset_file(const std::filesystem::path& path, uint64_t limit,
+                                                          std::string* why);
 
 // `reference` (a path relative to `folder`, e.g. a glTF buffer's decoded URI) resolved with every
 // symlink followed, when the result exists and lies inside `folder` (itself canonical: see

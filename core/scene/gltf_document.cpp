@@ -30,7 +30,7 @@ class DocumentReader {
 
   GltfDocument read() {
     std::string why;
-    std::optional<std::vector<unsigned char>> bytes = read_regular_file(path_, kMaxGlbFileBytes, &why);
+    std::optional<std::vector<unsigned char>> bytes = read_asset_file(path_, kMaxGlbFileBytes, &why);
     if (!bytes) fail(fmt::format("cannot read the glTF file: {}", why));
     std::optional<fs::path> folder = canonical_folder(path_, &why);
     if (!folder) fail(why);

@@ -85,7 +85,7 @@ bool read_external_file(std::vector<unsigned char>* out, std::string* err, const
   const std::optional<std::filesystem::path> file =
       resolve_inside_folder(files.folder, joined_path.substr(prefix.size()), &why);
   std::optional<std::vector<unsigned char>> bytes;
-  if (file) bytes = read_regular_file(*file, files.bytes_left, &why);
+  if (file) bytes = read_asset_file(*file, files.bytes_left, &why);
   if (!bytes) {
     if (err) *err = why;
     return false;

@@ -1,6 +1,8 @@
 // The PRT cache: content key (XXH3-128), a small checksummed binary file, atomic writes.
 #include "render/prt/prt_cache.h"
 
+#include "core/config/regular_file.h"
+
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <fmt/format.h>
@@ -155,11 +157,13 @@ bool read_exactly(int fd, char* out, size_t size) {
 
 std::optional<PrtTransfer> read_checked_prt_cache(const fs::path& file, const std::string& key, std::string* why_not,
                                                   const std::optional<PrtCacheShape>& expected) {
-  // O_NONBLOCK: a FIFO in the cache directory must not block the open; fstat then refuses it.
-  const int fd = ::open(file.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
-  if (fd < 0) {
-    if (errno == ENOENT) return reject(why_not, fmt::format("{}: no cache file", file.string()));
-    return reject(why_not, fmt::format("{}: cannot open: {}", file.string(), errno_text()));
+  if (!fs::exists(fs::symlink_status(file))) return reject(why_not, fmt::format("{}: no cache file", file.string()));
+  // The project's regular-file rule: a FIFO in the cache directory must not block, nor a device feed it.
+  int fd = -1;
+  try {
+    fd = open_regular_file(file, "PRT cache");
+  } catch (const FileAccessError& error) {
+    return reject(why_not, error.what());
   }
   struct Closer {
     int fd;
@@ -167,7 +171,6 @@ std::optional<PrtTransfer> read_checked_prt_cache(const fs::path& file, const st
   } closer{fd};
   struct stat info {};
   if (::fstat(fd, &info) != 0) return reject(why_not, fmt::format("{}: cannot stat: {}", file.string(), errno_text()));
-  if (!S_ISREG(info.st_mode)) return reject(why_not, fmt::format("{}: not a regular file", file.string()));
   const uint64_t size = uint64_t(std::max<off_t>(info.st_size, 0));
   if (size > kMaxPrtCacheBytes)
     return reject(why_not, fmt::format("{}: {} bytes, over the limit of {} bytes for a cache file", file.string(), size,

@@ -65,7 +65,7 @@ bool contains(const std::string& text, const std::string& part) { return text.fi
 TEST_F(PrtHostileCache, FifoIsAMissWithoutBlocking) {
   ASSERT_EQ(::mkfifo(file_.c_str(), 0600), 0);
   const std::string why = miss_reason();
-  EXPECT_TRUE(contains(why, "not a regular file")) << why;
+  EXPECT_TRUE(contains(why, "it is a FIFO (named pipe), expected a regular file")) << why;
   const PrtLoad load = load_or_bake_prt(mesh_, settings_, dir_);
   EXPECT_TRUE(load.baked);
 }
@@ -73,7 +73,7 @@ TEST_F(PrtHostileCache, FifoIsAMissWithoutBlocking) {
 TEST_F(PrtHostileCache, DirectoryIsAMiss) {
   fs::create_directories(file_);
   const std::string why = miss_reason();
-  EXPECT_TRUE(contains(why, "not a regular file")) << why;
+  EXPECT_TRUE(contains(why, "it is a directory, expected a regular file")) << why;
 }
 
 TEST_F(PrtHostileCache, FileOverTheSizeLimitIsAMissWithoutReadingIt) {
