@@ -1,6 +1,9 @@
 // arpiped's SIGHUP reloads on threads of their own (see background_reloads.h).
 #include "apps/arpiped/background_reloads.h"
 
+#include <sys/resource.h>
+#include <unistd.h>
+
 #include <atomic>
 #include <exception>
 #include <string>
@@ -11,6 +14,11 @@
 #include "core/pipeline/pipeline_runner.h"
 
 namespace arpipe {
+namespace {
+
+constexpr int kReloadNiceness = 10;
+
+}  // namespace
 
 struct BackgroundReloads::Shared {
   DaemonOptions options;
@@ -45,6 +53,9 @@ void BackgroundReloads::start() {
 bool BackgroundReloads::any_running() const { return shared_->running.load() > 0; }
 
 void BackgroundReloads::reload(const std::shared_ptr<Shared>& s, uint64_t ticket) {
+  // Below the pipeline's threads, and so are the bake's workers it starts (they inherit it): the
+  // frames keep their share of the CPU while a reload loads.
+  setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), kReloadNiceness);
   const std::string path = s->options.config_path.string();
   std::string error;
   bool accepted = false;

@@ -90,7 +90,7 @@ int run_daemon(const DaemonOptions& options) {
     // Stuck on a file or still baking: it holds nothing the outputs need (they are flushed), and
     // unwinding the process under it could not be done safely.
     log::info("a reload was still loading; exiting without waiting for it");
-    std::fflush(nullptr);
+    std::fflush(stderr);  // the log; never a FILE a stuck thread may hold
     _exit(0);
   }
   return 0;

@@ -64,7 +64,7 @@ std::optional<StartedPipeline> set_up_stoppably(const DaemonOptions& options, co
       }
       log::info("{} during setup ({}): exiting before the pipeline runs", sig == SIGTERM ? "SIGTERM" : "SIGINT",
                 state.step.load());
-      std::fflush(nullptr);
+      std::fflush(stderr);  // the log; never a FILE a stuck thread may hold
       _exit(kStoppedExitStatus);
     }
   }
