@@ -242,7 +242,9 @@ TEST_F(DaemonSignals, SlowReloadLoadsBesideTheRunningPipelineAndIsSuperseded) {
   EXPECT_EQ(accepted, 1u) << err;
 }
 
-// A reload stuck for good on a FIFO mesh: frames keep coming and the daemon still stops at once.
+// A reload naming a FIFO as its mesh: stuck for good where the loader opens it (or refused at once
+// where the glTF loader refuses FIFOs, as it now does); either way frames keep coming, it is never
+// accepted, and the daemon still stops at once.
 TEST_F(DaemonSignals, ReloadStuckOnAFifoMeshNeitherStallsFramesNorStop) {
   const fs::path config = write_config(kCapture);
   const std::string good = test::read_text(config);
