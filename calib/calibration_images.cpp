@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 #include <glob.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -12,11 +13,40 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "capture/recording/recording_reader.h"
+#include "core/config/regular_file.h"
+#include "core/image/image_header.h"
+#include "core/scene/asset_error.h"
 #include "core/image/pixel_convert.h"
 
 namespace arpipe::calib {
 
 namespace {
+
+// Photographs are hostile input: a FIFO matched by the glob must not block imread, and a PNG or
+// JPEG that declares 30000 x 30000 pixels in a small file is refused before it is decoded.
+constexpr int64_t kMaxImageSide = 16384;
+constexpr int64_t kMaxImagePixels = int64_t{1} << 27;  // 128 Mpixel; a 9x6 board photo is a few Mpixel
+
+bool has_png_or_jpeg_signature(int fd) {
+  unsigned char magic[4] = {};
+  const ssize_t n = ::pread(fd, magic, sizeof magic, 0);
+  return (n >= 4 && magic[0] == 0x89 && magic[1] == 'P' && magic[2] == 'N' && magic[3] == 'G') ||
+         (n >= 2 && magic[0] == 0xff && magic[1] == 0xd8);
+}
+
+void check_image_file(const std::string& file) {
+  try {
+    const int fd = open_regular_file(file, "image");
+    const bool checkable = has_png_or_jpeg_signature(fd);
+    ::close(fd);
+    // Other formats (TIFF, BMP, ...) are left to OpenCV's own limit (CV_IO_MAX_IMAGE_PIXELS).
+    if (checkable) check_image_limits(read_image_header(file), file, "calibration image", kMaxImageSide, kMaxImagePixels);
+  } catch (const FileAccessError& e) {
+    throw CalibrationInputError(e.what());
+  } catch (const AssetError& e) {
+    throw CalibrationInputError(e.what());
+  }
+}
 
 class GlobImages final : public CalibrationImages {
  public:
@@ -33,6 +63,7 @@ class GlobImages final : public CalibrationImages {
     std::error_code ec;
     if (!std::filesystem::exists(file, ec))  // gone since the glob; imread would only log a warning
       throw CalibrationInputError(fmt::format("{}: cannot read image: it no longer exists", file));
+    check_image_file(file);
     cv::Mat image;
     try {
       // The sensor's own pixel grid: an EXIF rotation would make some images a different camera.

@@ -2,6 +2,7 @@
 // name the pattern or the file; and a recording's frames as full-range luma.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <algorithm>
 #include <cmath>
@@ -11,6 +12,7 @@
 #include <thread>
 
 #include "tests/calib/calib_test_support.h"
+#include "tests/support/png_declaring.h"
 
 namespace arpipe::calib {
 namespace {
@@ -142,6 +144,27 @@ TEST(CalibrationImages, RecordingErrorsNameTheDirectory) {
   EXPECT_EQ(error_of([&] { images->load(count); }),
             fmt::format("{}: no frame {} (the recording has {})", calib_capture().string(), count, count));
   remove_scratch(dir);
+}
+
+// Issue 18: photographs are hostile input. Before: a 30000 x 30000 PNG header in a small file was
+// decoded (2.7 GB of grey pixels); a FIFO the glob matched blocked imread forever.
+TEST(CalibrationImages, AHugeDeclaredPngIsRefusedBeforeDecoding) {
+  const fs::path dir = scratch_dir("huge");
+  const fs::path png = arpipe::test::png_declaring(dir, 30000, 30000, "view-01.png");
+  const auto images = images_from_glob((dir / "view-*").string());
+  ASSERT_EQ(images->count(), 1u);
+  EXPECT_EQ(error_of([&] { images->load(0); }),
+            "calibration image \"" + png.string() +
+                "\": a 30000 x 30000 PNG image exceeds the limit of 16384 pixels a side and 134217728 pixels in all");
+}
+
+TEST(CalibrationImages, AFifoMatchedByTheGlobIsRefusedWithoutBlocking) {
+  const fs::path dir = scratch_dir("fifo");
+  ASSERT_EQ(::mkfifo((dir / "view-01.png").c_str(), 0600), 0);
+  const auto images = images_from_glob((dir / "view-*").string());
+  ASSERT_EQ(images->count(), 1u);
+  EXPECT_EQ(error_of([&] { images->load(0); }),
+            (dir / "view-01.png").string() + ": cannot read image: it is a FIFO (named pipe), expected a regular file");
 }
 
 }  // namespace

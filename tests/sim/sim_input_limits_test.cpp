@@ -17,6 +17,7 @@
 #include "capture/sim/simulator.h"
 #include "core/image/image_header.h"
 #include "core/scene/asset_error.h"
+#include "tests/support/png_declaring.h"
 
 namespace arpipe::sim {
 namespace {
@@ -30,35 +31,7 @@ fs::path scratch(const std::string& name) {
   return dir;
 }
 
-std::string read_bytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-uint32_t crc32_of(const std::string& bytes) {  // PNG's CRC (ISO 3309), bitwise
-  uint32_t crc = 0xffffffffu;
-  for (const unsigned char c : bytes) {
-    crc ^= c;
-    for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xedb88320u & (0u - (crc & 1u)));
-  }
-  return ~crc;
-}
-
-void put_big_endian(std::string& bytes, size_t at, uint32_t value) {
-  for (int i = 0; i < 4; ++i) bytes[at + size_t(i)] = char((value >> (24 - 8 * i)) & 0xff);
-}
-
-// A small, valid PNG whose IHDR (CRC fixed up) declares width x height: a decoder believes it.
-fs::path png_declaring(const fs::path& dir, uint32_t width, uint32_t height) {
-  const fs::path path = dir / "huge.png";
-  EXPECT_TRUE(cv::imwrite(path.string(), cv::Mat(4, 4, CV_8UC3, cv::Scalar(10, 20, 30))));
-  std::string bytes = read_bytes(path);
-  put_big_endian(bytes, 16, width);
-  put_big_endian(bytes, 20, height);
-  put_big_endian(bytes, 29, crc32_of(bytes.substr(12, 17)));  // over "IHDR" and its 13 data bytes
-  std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
-  return path;
-}
+using arpipe::test::png_declaring;
 
 std::string scene_error(const std::string& text, const fs::path& base) {
   try {
