@@ -1,6 +1,6 @@
 // libFuzzer target: HDR light probes read from a file, as the loaders read them: read_hdr_image
 // (core/image: the magic picks OpenEXR or Radiance, then the texel check), and the simulator's sky
-// (capture/sim EnvironmentMap, through OpenCV's imread). Bad input must be an AssetError; a
+// (capture/sim EnvironmentMap, through the same reader). Bad input must be an AssetError; a
 // decoded image must hold 3 floats per pixel.
 #include <cstddef>
 #include <cstdint>
