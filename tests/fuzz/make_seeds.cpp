@@ -1,6 +1,6 @@
 // Writes the fuzz targets' seed inputs with the project's own writers (valid files of every kind
-// the parsers read), one folder per target: fuzz_make_seeds OUT_DIR. scripts/fuzz.sh --seed
-// runs it; the committed corpora (tests/fuzz/corpus) are these, merged and minimised.
+// the parsers read), one folder per target: fuzz_make_seeds OUT_DIR (docs/FUZZING.md). The
+// committed corpora (tests/fuzz/corpus) started as these.
 #include <ImfRgbaFile.h>
 #include <ImfTiledRgbaFile.h>
 
