@@ -16,20 +16,13 @@ cd "$(dirname "$0")/.."
 
 all_targets=(fuzz_gltf fuzz_config fuzz_sim_scene fuzz_board fuzz_recording fuzz_radiance_hdr fuzz_openexr
              fuzz_png_jpeg fuzz_cameramodel fuzz_prt_cache)
-# Seeds beyond the target's own tests/fuzz/corpus/<target>/: the project's valid files and the
-# modules' own bad-input corpora where they exist (libFuzzer reads corpus folders recursively).
-declare -A extra_seeds=(
-  [fuzz_gltf]="tests/scene/corpus"
-  [fuzz_config]="configs tests/core/corpus/config"
-  [fuzz_sim_scene]="configs/sim tests/capture/corpus/sim"
-  [fuzz_board]="configs/boards tests/calib/corpus"
-  [fuzz_recording]=""  # recording folders are joined into the target's one-file form below
-  [fuzz_radiance_hdr]="tests/hdr/corpus tests/core/corpus/hdr"
-  [fuzz_openexr]="tests/hdr/corpus tests/core/corpus/hdr"
-  [fuzz_png_jpeg]="tests/capture/corpus/images"
-  [fuzz_cameramodel]="tests/core/corpus/cameramodel"
-  [fuzz_prt_cache]="tests/prt/corpus"
-)
+# Seeds beyond the target's own tests/fuzz/corpus/<target>/, one line per target (shared with the
+# ctest runs in tests/fuzz/CMakeLists.txt); libFuzzer reads corpus folders recursively.
+declare -A extra_seeds=()
+while read -r target dirs; do
+  case "$target" in ''|'#'*) continue ;; esac
+  extra_seeds[$target]=$dirs
+done <tests/fuzz/seed_dirs.txt
 # fuzz_recording reads one file: a recording's parts joined by its separator line
 # (tests/fuzz/fuzz_recording.cpp); every recording folder under tests/capture/corpus becomes one.
 join_recordings() {
