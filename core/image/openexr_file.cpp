@@ -31,6 +31,10 @@ namespace {
 constexpr int kMaxSide = 32768;
 constexpr int64_t kMaxPixels = int64_t{1} << 28;
 constexpr int kBand = 16;  // rows per readPixels call
+// Header attributes: a light probe's are a few dozen bytes each (a preview image the most); a type
+// OpenEXR does not know is kept as opaque bytes, which nothing here reads.
+constexpr uint32_t kMaxAttributeBytes = uint32_t{1} << 24;        // 16 MiB (a 2048 x 2048 preview)
+constexpr uint32_t kMaxUnknownAttributeBytes = uint32_t{1} << 16;  // 64 KiB
 
 void check_size(const Imath::Box2i& window, const std::string& name) {
   const int64_t width = int64_t{window.max.x} - window.min.x + 1, height = int64_t{window.max.y} - window.min.y + 1;
@@ -40,11 +44,13 @@ void check_size(const Imath::Box2i& window, const std::string& name) {
                                  name, window.min.x, window.min.y, window.max.x, window.max.y, width, height, kMaxSide));
 }
 
-// The library trusts the header: an attribute size or a data window from a corrupt file makes it
-// allocate gigabytes before it notices the file is short. So walk the header(s) first and check
-// every attribute size against the bytes really there, the data window against our limits, tile
-// sizes (at most 2^24 pixels a tile) and the channel count (light probes have a handful; at most
-// 64), before the library sees the file.
+// The library trusts the header: an attribute size, a channel list or a data window from a corrupt
+// file makes it allocate gigabytes before it notices the file is short. So walk the header(s) first,
+// the way the library will: every attribute's declared size against the bytes really there (and
+// 16 MiB), no name twice, every value of a known type exactly that type's layout, unknown types at
+// most 64 KiB; the data window against our limits, tile sizes (at most 2^24 pixels a tile), the
+// channel count (light probes have a handful; at most 64) and the chunk offset tables against the
+// bytes after the headers, before the library sees the file.
 class ExrHeaderCheck {
  public:
   ExrHeaderCheck(const std::filesystem::path& path, const std::string& name) : in_(path, std::ios::binary), name_(name) {
@@ -58,19 +64,24 @@ class ExrHeaderCheck {
     const uint32_t version = read_u32("the version field");
     if (magic != 20000630)
       throw AssetError(fmt::format("{}: byte 0: not an OpenEXR file (magic 76 2f 31 01 expected)", name_));
-    const bool multipart = (version & 0x1000) != 0;
-    tiled_flag_ = !multipart && (version & 0x200) != 0;
+    multipart_ = (version & 0x1000) != 0;
+    tiled_flag_ = !multipart_ && (version & 0x200) != 0;
     for (int part = 0;; ++part) {
       const bool empty = read_header();
-      if (!multipart) break;
+      if (!multipart_) break;
       if (empty) break;  // multi-part: an empty header ends the list
       if (part > 64) fail("more than 64 parts");
     }
+    if (chunks_ > (size_ - position_) / 8)
+      fail(fmt::format("the header(s) declare {} chunks, whose offset table ({} bytes) is longer than the {} bytes "
+                       "left in the file",
+                       chunks_, chunks_ * 8, size_ - position_));
   }
 
  private:
-  [[noreturn]] void fail(const std::string& what) const {
-    throw AssetError(fmt::format("{}: OpenEXR header (byte {}): {}", name_, position_, what));
+  [[noreturn]] void fail(const std::string& what) const { fail_at(position_, what); }
+  [[noreturn]] void fail_at(uint64_t byte, const std::string& what) const {
+    throw AssetError(fmt::format("{}: OpenEXR header (byte {}): {}", name_, byte, what));
   }
   void read_bytes(char* out, uint64_t count, std::string_view what) {
     if (size_ - position_ < count) fail(fmt::format("the file ends inside {}", what));
@@ -120,49 +131,172 @@ class ExrHeaderCheck {
   // Returns true for an empty header (the end of a multi-part file's header list).
   bool read_header() {
     std::map<std::string, std::pair<std::string, uint32_t>> seen;  // name -> type, size
+    std::map<std::string, uint64_t> offsets;                        // name -> byte where it starts
     for (int attributes = 0;; ++attributes) {
+      const uint64_t start = position_;
       const std::string attribute = read_name("an attribute name");
       if (attribute.empty()) {
-        if (attributes > 0) check_required(seen);
+        if (attributes > 0) {
+          check_required(seen);
+          count_chunks(seen);
+        }
         return attributes == 0;
       }
+      if (attributes >= 10000) fail("more than 10000 attributes");
       const std::string type = read_name("an attribute type");
       const uint32_t size = read_u32("an attribute size");
+      // The library keeps the last of two same-named attributes, and reads a predefined one into the
+      // default it already holds: a repeated name is where it and this walk part ways.
+      if (const auto first = offsets.find(attribute); first != offsets.end())
+        fail_at(start, fmt::format("attribute \"{}\" appears a second time (first at byte {})", attribute, first->second));
+      offsets[attribute] = start;
       seen[attribute] = {type, size};
       if (size > size_ - position_)
-        fail(fmt::format("attribute \"{}\" declares {} bytes, but only {} follow", attribute, size, size_ - position_));
+        fail(fmt::format("attribute \"{}\" declares {} bytes, but only {} follow", attribute, size,
+                                   size_ - position_));
+      if (size > kMaxAttributeBytes)
+        fail(fmt::format("attribute \"{}\" declares {} bytes (at most {} an attribute)", attribute, size,
+                                   kMaxAttributeBytes));
+      const uint64_t value_start = position_;
       std::vector<char> value(size);
       read_bytes(value.data(), size, "an attribute value");
-      const auto i32 = [&](size_t at) {
-        uint32_t v = 0;
-        for (int k = 3; k >= 0; --k) v = v << 8 | static_cast<unsigned char>(value[at + static_cast<size_t>(k)]);
-        return static_cast<int32_t>(v);
-      };
-      if (attribute == "dataWindow" && type == "box2i" && size == 16) {
-        Imath::Box2i window;
-        window.min.x = i32(0), window.min.y = i32(4), window.max.x = i32(8), window.max.y = i32(12);
-        check_size(window, name_);
-      } else if (attribute == "tiles" && type == "tiledesc" && size == 9) {
-        const uint64_t x = static_cast<uint32_t>(i32(0)), y = static_cast<uint32_t>(i32(4));
-        if (x < 1 || y < 1 || x * y > (uint64_t{1} << 24))
-          fail(fmt::format("tiles of {} x {} pixels (at most 2^24 pixels a tile)", x, y));
-      } else if (attribute == "channels" && type == "chlist") {
-        int channels = 0;
-        for (size_t at = 0; at < value.size() && value[at] != 0; ++channels) {
-          while (at < value.size() && value[at] != 0) ++at;  // the channel's name
-          at += 1 + 16;                                      // its terminator, type, pLinear, reserved, sampling
-        }
-        if (channels > 64) fail(fmt::format("{} channels (a light probe needs a handful; at most 64)", channels));
-        if (channels == 0) fail("no channels (an image needs at least one)");
-      }
-      if (attributes > 10000) fail("more than 10000 attributes");
+      check_value(value_start, attribute, type, value);
     }
   }
+
+  // The library reads every attribute of a type it knows by that type's layout, not by the size the
+  // file declares (a chlist up to its empty name, a box2i as 16 bytes, a preview as width x height
+  // pixels), and allocates an unknown type's declared size. So each value must be exactly what its
+  // type's layout reads, or this walk and the library disagree on where the next attribute starts.
+  void check_value(uint64_t value_start, const std::string& attribute, const std::string& type,
+                   const std::vector<char>& value) {
+    const auto fail_here = [&](const std::string& what) {
+      fail_at(value_start, fmt::format("attribute \"{}\" ({}, {} bytes): {}", attribute, type, value.size(), what));
+    };
+    const auto u32 = [&](size_t at) {
+      uint32_t v = 0;
+      for (int k = 3; k >= 0; --k) v = v << 8 | static_cast<unsigned char>(value[at + static_cast<size_t>(k)]);
+      return v;
+    };
+    const auto i32 = [&](size_t at) { return static_cast<int32_t>(u32(at)); };
+    static const std::map<std::string, uint32_t, std::less<>> kFixedSizes = {
+        {"box2i", 16},         {"box2f", 16},       {"chromaticities", 32}, {"compression", 1}, {"deepImageState", 1},
+        {"double", 8},         {"envmap", 1},       {"float", 4},           {"int", 4},         {"keycode", 28},
+        {"lineOrder", 1},      {"m33f", 36},        {"m33d", 72},           {"m44f", 64},       {"m44d", 128},
+        {"rational", 8},       {"tiledesc", 9},     {"timecode", 8},        {"v2i", 8},         {"v2f", 8},
+        {"v2d", 16},           {"v3i", 12},         {"v3f", 12},            {"v3d", 24}};
+    if (const auto fixed = kFixedSizes.find(type); fixed != kFixedSizes.end()) {
+      if (value.size() != fixed->second) fail_here(fmt::format("a {} is {} bytes", type, fixed->second));
+    } else if (type == "chlist") {
+      // Channels: name, NUL, pixel type, pLinear, 3 reserved bytes, x and y sampling; an empty name ends it.
+      int channels = 0;
+      size_t at = 0;
+      for (;; ++channels) {
+        if (at >= value.size()) fail_here("the channel list has no terminating empty name inside the value");
+        if (value[at] == 0) break;
+        const size_t name_start = at;
+        while (at < value.size() && value[at] != 0) ++at;
+        if (at >= value.size() || at - name_start > 255)
+          fail_here(fmt::format("channel {}'s name is not NUL-terminated within 255 bytes", channels));
+        const std::string channel(value.data() + name_start, at - name_start);
+        ++at;
+        if (value.size() - at < 16) fail_here(fmt::format("channel \"{}\" is cut off", channel));
+        const uint32_t pixel_type = u32(at);
+        const int32_t x_sampling = i32(at + 8), y_sampling = i32(at + 12);
+        if (pixel_type > 2)
+          fail_here(fmt::format("channel \"{}\" has pixel type {} (expected 0 UINT, 1 HALF or 2 FLOAT)", channel,
+                                pixel_type));
+        if (x_sampling < 1 || y_sampling < 1)
+          fail_here(fmt::format("channel \"{}\" has sampling {} x {} (expected at least 1)", channel, x_sampling,
+                                y_sampling));
+        at += 16;
+        if (channels >= 64) fail_here("more than 64 channels (a light probe needs a handful)");
+      }
+      if (at + 1 != value.size())
+        fail_here(fmt::format("the channel list ends at byte {} of the value, not at its end", at + 1));
+      if (channels == 0) fail_here("no channels (an image needs at least one)");
+    } else if (type == "string") {
+      // read as exactly its size
+    } else if (type == "stringvector") {
+      for (size_t at = 0; at < value.size();) {
+        if (value.size() - at < 4) fail_here(fmt::format("a string's length at byte {} of the value is cut off", at));
+        const uint32_t length = u32(at);
+        at += 4;
+        if (length > value.size() - at)
+          fail_here(fmt::format("a string of {} bytes at byte {} of the value overruns it", length, at - 4));
+        at += length;
+      }
+    } else if (type == "floatvector") {
+      if (value.size() % 4 != 0) fail_here("a floatvector is a whole number of 4-byte floats");
+    } else if (type == "preview") {
+      if (value.size() < 8) fail_here("a preview starts with its width and height");
+      const uint64_t width = u32(0), height = u32(4);
+      if (8 + 4 * width * height != value.size())
+        fail_here(fmt::format("a {} x {} preview is {} bytes", width, height, 8 + 4 * width * height));
+    } else if (type == "idmanifest") {
+      if (value.size() < 4) fail_here("an idmanifest starts with its 4-byte uncompressed size");
+    } else if (value.size() > kMaxUnknownAttributeBytes) {
+      fail_here(fmt::format("an attribute of a type OpenEXR does not know may hold at most {} bytes",
+                            kMaxUnknownAttributeBytes));
+    }
+
+    if (attribute == "dataWindow" && type == "box2i") {
+      Imath::Box2i window;
+      window.min.x = i32(0), window.min.y = i32(4), window.max.x = i32(8), window.max.y = i32(12);
+      check_size(window, name_);
+      facts_.width = static_cast<uint64_t>(int64_t{window.max.x} - window.min.x + 1);
+      facts_.height = static_cast<uint64_t>(int64_t{window.max.y} - window.min.y + 1);
+    } else if (attribute == "tiles" && type == "tiledesc") {
+      const uint64_t x = u32(0), y = u32(4);
+      facts_.tile_x = x, facts_.tile_y = y;
+      if (x < 1 || y < 1 || x * y > (uint64_t{1} << 24))
+        fail_here(fmt::format("tiles of {} x {} pixels (at most 2^24 pixels a tile)", x, y));
+      const unsigned mode = static_cast<unsigned char>(value[8]);
+      if ((mode & 0x0f) > 2 || (mode >> 4) > 1)
+        fail_here(fmt::format("level mode {} and rounding mode {} (expected 0..2 and 0..1)", mode & 0x0f, mode >> 4));
+    } else if (attribute == "compression" && type == "compression") {
+      if (static_cast<unsigned char>(value[0]) > 9)
+        fail_here(fmt::format("compression {} (OpenEXR knows 0..9)", static_cast<unsigned char>(value[0])));
+      facts_.compression = static_cast<unsigned char>(value[0]);
+    } else if (attribute == "chunkCount" && type == "int") {
+      if (i32(0) < 0) fail_here(fmt::format("a chunk count of {}", i32(0)));
+      facts_.chunk_count = static_cast<uint32_t>(i32(0));
+    }
+  }
+
+  // The library allocates one 8-byte offset per chunk (scanline block or tile) before it reads
+  // any: the offset tables must fit in the bytes after the headers. Counted per part; a multi-part
+  // file says its count ("chunkCount"), a single-part one follows from the data window,
+  // compression and tile size (level 0 only: a lower bound for mipmaps).
+  void count_chunks(const std::map<std::string, std::pair<std::string, uint32_t>>& seen) {
+    uint64_t chunks = 0;
+    if (multipart_) {
+      if (!seen.contains("chunkCount")) fail("the required attribute \"chunkCount\" (int) of a multi-part file is missing");
+      chunks = facts_.chunk_count;
+    } else if (tiled_flag_) {
+      chunks = ((facts_.width + facts_.tile_x - 1) / facts_.tile_x) * ((facts_.height + facts_.tile_y - 1) / facts_.tile_y);
+    } else {
+      static constexpr uint64_t kLinesPerChunk[10] = {1, 1, 1, 16, 32, 16, 32, 32, 32, 256};  // NONE .. DWAB
+      const uint64_t lines = kLinesPerChunk[facts_.compression];
+      chunks = (facts_.height + lines - 1) / lines;
+    }
+    chunks_ += chunks;
+    facts_ = {};
+  }
+
+  // What count_chunks needs from the header being walked (check_required has made sure each is set).
+  struct HeaderFacts {
+    uint64_t width = 1, height = 1, tile_x = 1, tile_y = 1, chunk_count = 0;
+    unsigned compression = 0;
+  };
 
   std::ifstream in_;
   const std::string& name_;
   uint64_t size_ = 0, position_ = 0;
+  bool multipart_ = false;
   bool tiled_flag_ = false;  // single-part tiled file (version flag 0x200): its header needs "tiles"
+  HeaderFacts facts_;
+  uint64_t chunks_ = 0;  // offset-table entries of all parts so far
 };
 
 void append_band(HdrImage& image, int rows) {
