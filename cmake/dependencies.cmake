@@ -5,6 +5,7 @@ find_package(OpenCV 4 REQUIRED COMPONENTS core imgproc calib3d imgcodecs)
 find_package(apriltag REQUIRED)
 find_package(nlohmann_json 3 REQUIRED)
 find_package(ZLIB REQUIRED)
+find_package(PNG REQUIRED)  # simulator textures: PNG decoded by libpng, not by OpenCV's format probing
 find_package(embree 3 REQUIRED)  # target: embree (the simulator's ray caster)
 find_package(fmt REQUIRED)
 pkg_check_modules(TOMLPP REQUIRED IMPORTED_TARGET tomlplusplus)
