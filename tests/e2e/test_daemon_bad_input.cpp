@@ -11,27 +11,17 @@
 
 #include "capture/recording/recording_reader.h"
 #include "tests/e2e/child_process.h"
+#include "tests/e2e/e2e_test_dir.h"
 
 namespace fs = std::filesystem;
 using namespace arpipe;
 
 namespace {
 
-const fs::path kCapture = fs::path(ARPIPE_BINARY_DIR) / "default-capture";
+const fs::path& kCapture = test::kDefaultCapture;
 
-class DaemonInput : public ::testing::Test {
+class DaemonInput : public test::E2eTestDir {
  protected:
-  void SetUp() override {
-    dir_ = fs::path(ARPIPE_BINARY_DIR) / "e2e-out" / ::testing::UnitTest::GetInstance()->current_test_info()->name();
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  // A private copy of the default capture that a test may damage.
-  fs::path copy_capture() {
-    const fs::path copy = dir_ / "capture";
-    fs::copy(kCapture, copy, fs::copy_options::recursive);
-    return copy;
-  }
   // A config whose outputs all land in this test's directory.
   fs::path write_config(const fs::path& capture, const std::string& extra = "") {
     const fs::path path = dir_ / "arpipe.toml";
@@ -48,7 +38,6 @@ class DaemonInput : public ::testing::Test {
     return test::run_to_exit(test::build_program("arpiped"), args, dir_ / "logs", &err);
   }
   size_t result_lines() { return test::count_lines(dir_ / "results.jsonl"); }
-  fs::path dir_;
 };
 
 TEST_F(DaemonInput, MissingConfigFile) {

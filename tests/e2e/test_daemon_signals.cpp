@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "tests/e2e/child_process.h"
+#include "tests/e2e/e2e_test_dir.h"
 
 namespace fs = std::filesystem;
 using namespace arpipe;
@@ -25,7 +26,7 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-const fs::path kCapture = fs::path(ARPIPE_BINARY_DIR) / "default-capture";
+const fs::path& kCapture = test::kDefaultCapture;
 
 // "Within a second" of the requirement for a setup, with room for a loaded test machine.
 constexpr double kPromptSeconds = 1.5;
@@ -49,18 +50,8 @@ struct Ending {
   double seconds = 0;
 };
 
-class DaemonSignals : public ::testing::Test {
+class DaemonSignals : public test::E2eTestDir {
  protected:
-  void SetUp() override {
-    dir_ = fs::path(ARPIPE_BINARY_DIR) / "e2e-out" / ::testing::UnitTest::GetInstance()->current_test_info()->name();
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  fs::path copy_capture() {
-    const fs::path copy = dir_ / "capture";
-    fs::copy(kCapture, copy, fs::copy_options::recursive);
-    return copy;
-  }
   fs::path make_fifo(const std::string& name) {
     const fs::path path = dir_ / name;
     EXPECT_EQ(mkfifo(path.c_str(), 0600), 0) << path << ": " << std::strerror(errno);
@@ -121,7 +112,6 @@ class DaemonSignals : public ::testing::Test {
       else std::this_thread::sleep_for(std::chrono::milliseconds(20));
     return true;
   }
-  fs::path dir_;
 };
 
 // A recording whose frames.bin is a FIFO that nobody writes: open() would wait forever.

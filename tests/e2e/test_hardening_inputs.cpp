@@ -11,21 +11,17 @@
 #include <vector>
 
 #include "tests/e2e/child_process.h"
+#include "tests/e2e/e2e_test_dir.h"
 
 namespace fs = std::filesystem;
 using namespace arpipe;
 
 namespace {
 
-const fs::path kCapture = fs::path(ARPIPE_BINARY_DIR) / "default-capture";
+const fs::path& kCapture = test::kDefaultCapture;
 
-class HardeningInputs : public ::testing::Test {
+class HardeningInputs : public test::E2eTestDir {
  protected:
-  void SetUp() override {
-    dir_ = fs::path(ARPIPE_BINARY_DIR) / "e2e-out" / ::testing::UnitTest::GetInstance()->current_test_info()->name();
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
   // A config reading `capture` whose outputs all land in this test's directory.
   fs::path write_config(const fs::path& capture, const std::string& extra = "") {
     const fs::path path = dir_ / "arpipe.toml";
@@ -49,7 +45,6 @@ class HardeningInputs : public ::testing::Test {
   static bool contains(const std::string& text, const std::string& part) {
     return text.find(part) != std::string::npos;
   }
-  fs::path dir_;
 };
 
 TEST_F(HardeningInputs, ConfigCheckNamesAMissingMeshByItsKey) {
