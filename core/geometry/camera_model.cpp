@@ -396,6 +396,21 @@ CameraModel::CameraModel(const std::string& lensmodel, std::vector<double> intri
                                        intrinsics_[0], intrinsics_[1]));
   if (width <= 0 || height <= 0)
     throw CameraModelError(fmt::format("imager size must be positive, got {}x{}", width, height));
+  // A core far outside any real lens sends mrcal's unprojection solve into a loop that does not end
+  // (a fuzzed splined model with cy = 2.4e12 ran for minutes): refused here, with the limits.
+  if (m->metadata.has_core) {
+    constexpr double kMaxFocalPx = 1e7;     // a 16k-pixel sensor behind a 0.1-degree field of view is ~1e7
+    constexpr double kMaxCentreOffset = 10;  // the principal point within 10 imager sizes of the image
+    if (intrinsics_[0] > kMaxFocalPx || intrinsics_[1] > kMaxFocalPx)
+      throw CameraModelError(fmt::format("focal lengths of '{}' must be at most {} px, got fx={} fy={}", lensmodel,
+                                         kMaxFocalPx, intrinsics_[0], intrinsics_[1]));
+    const double cx = intrinsics_[2], cy = intrinsics_[3];
+    if (cx < -kMaxCentreOffset * width || cx > (kMaxCentreOffset + 1) * width || cy < -kMaxCentreOffset * height ||
+        cy > (kMaxCentreOffset + 1) * height)
+      throw CameraModelError(fmt::format(
+          "principal point of '{}' ({}, {}) is more than {} imager sizes outside the {}x{} image", lensmodel, cx, cy,
+          kMaxCentreOffset, width, height));
+  }
   char name[256];
   lensmodel_ = mrcal_lensmodel_name(name, sizeof name, &m->lensmodel) ? std::string(name) : lensmodel;
   mrcal_ = std::move(m);

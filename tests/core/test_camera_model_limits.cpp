@@ -59,6 +59,28 @@ TEST(CameraModelLimits, SplineConfigurationsMrcalAssertsOnAreRefused) {
   }
 }
 
+TEST(CameraModelLimits, ACoreFarOutsideAnyLensIsRefused) {
+  // tests/fuzz/regressions/fuzz_cameramodel/splined-cy-2.4e12-unproject-hang.cameramodel (found by
+  // CI's mutation run): cy = 2.4e12 loaded, then mrcal's unprojection ran for minutes.
+  const fs::path file = fs::path(ARPIPE_SOURCE_DIR) / "tests" / "fuzz" / "regressions" / "fuzz_cameramodel" /
+                        "splined-cy-2.4e12-unproject-hang.cameramodel";
+  try {
+    CameraModel::load(file);
+    ADD_FAILURE() << "expected a CameraModelError";
+  } catch (const CameraModelError& e) {
+    EXPECT_TRUE(contains(e.what(), "(320, 2429496729540) is more than 10 imager sizes outside the 640x480 image"))
+        << e.what();
+  }
+  try {
+    CameraModel("LENSMODEL_PINHOLE", {2e7, 500, 320, 240}, 640, 480);
+    ADD_FAILURE() << "expected a CameraModelError";
+  } catch (const CameraModelError& e) {
+    EXPECT_TRUE(contains(e.what(), "must be at most 10000000 px, got fx=20000000 fy=500")) << e.what();
+  }
+  // The edges of the allowed range still load: a principal point ten image widths to the left.
+  EXPECT_NO_THROW(CameraModel("LENSMODEL_PINHOLE", {500, 500, -6400, 240}, 640, 480));
+}
+
 TEST(CameraModelLimits, FilesAreRegularAndBounded) {
   const fs::path dir = fs::temp_directory_path() / ("arpipe_cameramodel_limits_" + std::to_string(::getpid()));
   fs::remove_all(dir);
