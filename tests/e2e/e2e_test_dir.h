@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
+#include <string>
 
 namespace arpipe::test {
 
@@ -23,6 +25,18 @@ class E2eTestDir : public ::testing::Test {
     const std::filesystem::path copy = dir_ / "capture";
     std::filesystem::copy(kDefaultCapture, copy, std::filesystem::copy_options::recursive);
     return copy;
+  }
+
+  // A config replaying `capture` as fast as it goes, whose outputs (PNGs, Y4M, results) all land
+  // in this test's directory; `extra` is appended TOML.
+  std::filesystem::path write_config(const std::filesystem::path& capture, const std::string& extra = "") const {
+    const std::filesystem::path path = dir_ / "arpipe.toml";
+    std::ofstream(path) << "[source]\npath = \"" << capture.string() << "\"\npacing = \"fast\"\n"
+                        << "[sinks.png]\ndir = \"" << (dir_ / "png").string() << "\"\n"
+                        << "[sinks.y4m]\npath = \"" << (dir_ / "out.y4m").string() << "\"\n"
+                        << "[sinks.results]\npath = \"" << (dir_ / "results.jsonl").string() << "\"\n"
+                        << extra;
+    return path;
   }
 
   std::filesystem::path dir_;

@@ -22,16 +22,6 @@ const fs::path& kCapture = test::kDefaultCapture;
 
 class DaemonInput : public test::E2eTestDir {
  protected:
-  // A config whose outputs all land in this test's directory.
-  fs::path write_config(const fs::path& capture, const std::string& extra = "") {
-    const fs::path path = dir_ / "arpipe.toml";
-    std::ofstream(path) << "[source]\npath = \"" << capture.string() << "\"\npacing = \"fast\"\n"
-                        << "[sinks.png]\ndir = \"" << (dir_ / "png").string() << "\"\n"
-                        << "[sinks.y4m]\npath = \"" << (dir_ / "out.y4m").string() << "\"\n"
-                        << "[sinks.results]\npath = \"" << (dir_ / "results.jsonl").string() << "\"\n"
-                        << extra;
-    return path;
-  }
   int run(const fs::path& config, std::string& err, std::vector<std::string> extra = {}) {
     std::vector<std::string> args{"--config", config.string()};
     args.insert(args.end(), extra.begin(), extra.end());

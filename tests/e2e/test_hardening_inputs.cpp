@@ -22,16 +22,6 @@ const fs::path& kCapture = test::kDefaultCapture;
 
 class HardeningInputs : public test::E2eTestDir {
  protected:
-  // A config reading `capture` whose outputs all land in this test's directory.
-  fs::path write_config(const fs::path& capture, const std::string& extra = "") {
-    const fs::path path = dir_ / "arpipe.toml";
-    std::ofstream(path) << "[source]\npath = \"" << capture.string() << "\"\npacing = \"fast\"\n"
-                        << "[sinks.png]\ndir = \"" << (dir_ / "png").string() << "\"\n"
-                        << "[sinks.y4m]\npath = \"" << (dir_ / "out.y4m").string() << "\"\n"
-                        << "[sinks.results]\npath = \"" << (dir_ / "results.jsonl").string() << "\"\n"
-                        << extra;
-    return path;
-  }
   // Exit status of a program of the build, -1000 when it ran past `timeout` (then killed).
   int run(const std::string& program, const std::vector<std::string>& args, std::string& err,
           std::chrono::seconds timeout = std::chrono::seconds(60)) {
