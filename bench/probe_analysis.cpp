@@ -12,7 +12,7 @@
 
 #include "capture/recording/recording_reader.h"
 #include "core/image/pixel_convert.h"
-#include "core/light/probe_light_estimator.h"
+#include "core/probe/probe_light_estimator.h"
 #include "core/log.h"
 
 using namespace arpipe;

@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
-#include "core/light/civil_time.h"
-#include "core/light/sun_direction.h"
-#include "core/light/sun_position_psa.h"
-#include "core/light/sun_position_spa.h"
+#include "core/sun/civil_time.h"
+#include "core/sun/sun_direction.h"
+#include "core/sun/sun_position_psa.h"
+#include "core/sun/sun_position_spa.h"
 
 using namespace arpipe;
 

@@ -75,7 +75,7 @@ std::string lensmodel_name(const mrcal_lensmodel_t& lensmodel) {
 // ---- Seed --------------------------------------------------------------------------------------
 
 // One view's seen points: board coordinates and pixels.
-struct SeedView {
+struct InitialGuessView {
   size_t input_index = 0;
   std::vector<cv::Point3d> object;
   std::vector<cv::Point2d> pixels;
@@ -91,7 +91,7 @@ struct ViewPose {
 // seed, re-projected to a pinhole of the same core, and given to IPPE (the board is planar). This is
 // mrcal's own seeding (calibration.py estimate_monocular_calobject_poses_Rt_tocam), with IPPE for
 // the iterative PnP. A board solved behind the camera is flipped (t -> -t) and re-solved.
-ViewPose seed_pose(const SeedView& view, const double core[4]) {
+ViewPose initial_guess_pose(const InitialGuessView& view, const double core[4]) {
   ViewPose pose;
   std::vector<mrcal_point2_t> q(view.pixels.size());
   for (size_t i = 0; i < q.size(); ++i) q[i] = mrcal_point2_t{{view.pixels[i].x, view.pixels[i].y}};
@@ -140,12 +140,12 @@ ViewPose seed_pose(const SeedView& view, const double core[4]) {
 // How well a focal length explains every view: the median of the per-view PnP reprojection RMS.
 // A tilted board's perspective pins the focal length (a fronto-parallel one does not: distance and
 // focal length trade off); the median keeps one odd view from steering the choice.
-double focal_cost(const std::vector<SeedView>& views, double f, double cx, double cy) {
+double focal_cost(const std::vector<InitialGuessView>& views, double f, double cx, double cy) {
   const double core[4] = {f, f, cx, cy};
   std::vector<double> rms;
   rms.reserve(views.size());
-  for (const SeedView& view : views) {
-    const ViewPose pose = seed_pose(view, core);
+  for (const InitialGuessView& view : views) {
+    const ViewPose pose = initial_guess_pose(view, core);
     rms.push_back(pose.ok ? pose.rms_px : std::numeric_limits<double>::infinity());
   }
   std::nth_element(rms.begin(), rms.begin() + long(rms.size() / 2), rms.end());
@@ -155,7 +155,7 @@ double focal_cost(const std::vector<SeedView>& views, double f, double cx, doubl
 // The stereographic focal length that best explains the views. Candidates cover horizontal fields of
 // view from 10 to 180 degrees (f = W / (4 tan(fov/4)), mrcal's stereographic focal estimate), then a
 // golden-section search in log f between the best candidate's neighbours refines it.
-double guess_focal(const std::vector<SeedView>& views, int width, double cx, double cy) {
+double guess_focal(const std::vector<InitialGuessView>& views, int width, double cx, double cy) {
   constexpr int kCandidates = 40;
   const double f_min = width / (4.0 * std::tan(180.0 * kPi / 180.0 / 4.0));
   const double f_max = width / (4.0 * std::tan(10.0 * kPi / 180.0 / 4.0));
@@ -268,7 +268,7 @@ CalibrationResult solve_calibration(const CalibrationBoard& board, const std::ve
                                        board.name, board.rows, board.cols, board.spacing_m));
 
   // ---- Usable views
-  std::vector<SeedView> views;
+  std::vector<InitialGuessView> views;
   std::vector<std::string> sparse_views;
   for (size_t v = 0; v < observations.size(); ++v) {
     const BoardObservation& obs = observations[v];
@@ -280,7 +280,7 @@ CalibrationResult solve_calibration(const CalibrationBoard& board, const std::ve
       throw CalibrationError(fmt::format("{}: image is {}x{}, the calibration is for {}x{}; calibrate each camera "
                                          "resolution separately",
                                          obs.image, obs.width, obs.height, width, height));
-    SeedView view;
+    InitialGuessView view;
     view.input_index = v;
     std::vector<char> rows_seen(size_t(board.rows), 0), cols_seen(size_t(board.cols), 0);
     for (int r = 0; r < board.rows; ++r)
@@ -313,11 +313,11 @@ CalibrationResult solve_calibration(const CalibrationBoard& board, const std::ve
   const double cx = (width - 1) / 2.0, cy = (height - 1) / 2.0;
   const double focal = options.focal_guess_px > 0 ? options.focal_guess_px : guess_focal(views, width, cx, cy);
   const double core[4] = {focal, focal, cx, cy};
-  std::vector<SeedView> seeded;
+  std::vector<InitialGuessView> seeded;
   std::vector<ViewPose> poses;
   std::vector<std::string> failed;
-  for (SeedView& view : views) {
-    const ViewPose pose = seed_pose(view, core);
+  for (InitialGuessView& view : views) {
+    const ViewPose pose = initial_guess_pose(view, core);
     if (!pose.ok) {
       failed.push_back(observations[view.input_index].image);
       continue;

@@ -12,9 +12,9 @@
 #include "core/image/pixel_convert.h"
 #include "core/log.h"
 #include "core/pipeline/monotonic_clock.h"
-#include "render/fullscreen_triangle.h"
-#include "render/gl_error.h"
-#include "render/render_errors.h"
+#include "render/gl/fullscreen_triangle.h"
+#include "render/gl/gl_error.h"
+#include "render/gl/render_errors.h"
 
 namespace arpipe {
 namespace {

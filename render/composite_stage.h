@@ -9,11 +9,11 @@
 #include <vector>
 
 #include "core/pipeline/stage.h"
-#include "render/gl_objects.h"
-#include "render/gl_program.h"
-#include "render/lens_mode.h"
-#include "render/lens_undistortion.h"
-#include "render/per_model_cache.h"
+#include "render/gl/gl_objects.h"
+#include "render/gl/gl_program.h"
+#include "render/lens/lens_mode.h"
+#include "render/lens/lens_undistortion.h"
+#include "render/lens/per_model_cache.h"
 #include "render/render_session.h"
 
 namespace arpipe {

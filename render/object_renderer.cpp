@@ -5,8 +5,8 @@
 
 #include <array>
 
-#include "core/light/sh_rotation.h"
-#include "render/shadow_lookup_glsl.h"
+#include "core/sh/sh_rotation.h"
+#include "render/shadow/shadow_lookup_glsl.h"
 
 namespace arpipe {
 namespace {

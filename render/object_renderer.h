@@ -7,11 +7,11 @@
 #include <map>
 #include <span>
 
-#include "render/gl_program.h"
-#include "render/lens_projection.h"
-#include "render/render_objects.h"
+#include "render/gl/gl_program.h"
+#include "render/lens/lens_projection.h"
+#include "render/uploaded_objects.h"
 #include "render/row_poses.h"
-#include "render/shadow_map.h"
+#include "render/shadow/shadow_map.h"
 
 namespace arpipe {
 
@@ -34,12 +34,12 @@ struct Lighting {
 };
 
 struct ObjectAtInstant {
-  const RenderObject* object = nullptr;
+  const UploadedObject* object = nullptr;
   RowPoses poses;  // T_cam_object per row, without the scale
 };
 
 struct ObjectOverExposure {
-  const RenderObject* object = nullptr;
+  const UploadedObject* object = nullptr;
   RowPoses start, mid, end;  // at the start, middle and end of each row's exposure
 };
 
@@ -52,7 +52,7 @@ class ObjectRenderer {
 
   // Linear, premultiplied colour with depth test, into the bound framebuffer (viewport and
   // scissor as set by the caller), with the lens as the projection. A shadow catcher
-  // (RenderObject::shadow_catcher) draws no colour: its alpha is 1 - the ratio by which the
+  // (UploadedObject::shadow_catcher) draws no colour: its alpha is 1 - the ratio by which the
   // virtual objects' shadow darkens the real ground, (ambient + visibility * direct) /
   // (ambient + direct) in luminance, so the composite multiplies the camera frame by that ratio.
   void draw(const LensUniforms& lens, const RowProjection& rows, const Lighting& lighting,

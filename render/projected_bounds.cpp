@@ -6,7 +6,7 @@
 #include <cmath>
 #include <vector>
 
-#include "render/lens_projection.h"
+#include "render/lens/lens_projection.h"
 
 namespace arpipe {
 namespace {

@@ -3,7 +3,7 @@
 #include "render/render_session.h"
 
 #include "core/log.h"
-#include "render/render_errors.h"
+#include "render/gl/render_errors.h"
 
 namespace arpipe {
 

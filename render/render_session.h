@@ -7,7 +7,7 @@
 #include <memory>
 #include <string>
 
-#include "render/egl_context.h"
+#include "render/gl/egl_context.h"
 #include "render/pixel_rect.h"
 #include "render/virtual_layer.h"
 

@@ -12,14 +12,14 @@
 #include <optional>
 #include <stdexcept>
 
-#include "core/light/sh9.h"
+#include "core/sh/sh9.h"
 #include "core/log.h"
 #include "core/pipeline/monotonic_clock.h"
-#include "render/gl_error.h"
-#include "render/lens_projection.h"
-#include "render/lens_undistortion.h"
+#include "render/gl/gl_error.h"
+#include "render/lens/lens_projection.h"
+#include "render/lens/lens_undistortion.h"
 #include "render/projected_bounds.h"
-#include "render/render_errors.h"
+#include "render/gl/render_errors.h"
 
 namespace arpipe {
 namespace {
@@ -38,7 +38,7 @@ constexpr double kIrradianceOverPi[3] = {1.0, 2.0 / 3.0, 0.25};
 // What the render stage's loader reads away from the processing thread: the objects' meshes and
 // their PRT transfers, on the CPU.
 struct RenderAssets final : StageAssets {
-  RenderMeshes meshes;
+  LoadedMeshes meshes;
 };
 
 }  // namespace
@@ -57,7 +57,7 @@ RenderStage::~RenderStage() {
 StageAssetLoader RenderStage::asset_loader() const {
   return [](const Config& config) -> std::shared_ptr<const StageAssets> {
     auto assets = std::make_shared<RenderAssets>();
-    assets->meshes = load_render_meshes(config);
+    assets->meshes = load_object_meshes(config);
     return assets;
   };
 }
@@ -71,7 +71,7 @@ void RenderStage::configure_loaded(const Config& config, const std::shared_ptr<c
   session_->make_current();
   if (!drawer_) drawer_ = std::make_unique<MotionBlurDrawer>(session_->context(), session_->layer().color_format());
   drawer_->prepare(parse_blur_method(config.render.blur.method));
-  std::vector<RenderObject> objects = upload_render_objects(config, loaded->meshes);
+  std::vector<UploadedObject> objects = upload_objects(config, loaded->meshes);
 
   Settings settings;
   settings.enabled = config.render.enabled;
@@ -190,7 +190,7 @@ void RenderStage::draw(FrameContext& ctx) {
   }
   LayerDrawRequest request;
   PixelRect rect;  // in the output image
-  for (const RenderObject& object : objects_) {
+  for (const UploadedObject& object : objects_) {
     bool in_view = false;
     for (const SE3& T_cam_world : exposure_poses) {
       if (std::optional<PixelRect> object_rect =
@@ -221,7 +221,7 @@ void RenderStage::draw(FrameContext& ctx) {
   request.lighting.shadow = shadow_for(ctx, request.lighting, angular_diameter_rad, request.objects);
   if (request.lighting.shadow) {
     // The catcher's patch joins the footprint where it is in view.
-    const RenderObject& catcher = *request.objects.back();
+    const UploadedObject& catcher = *request.objects.back();
     for (const SE3& T_cam_world : exposure_poses)
       if (std::optional<PixelRect> r =
               projected_box_rect(image_camera, T_cam_world * catcher.T_world_object, catcher.bounds, kRectMarginPx))
@@ -297,7 +297,7 @@ Lighting RenderStage::frame_lighting(const FrameContext& ctx, double& angular_di
 }
 
 const ShadowLookup* RenderStage::shadow_for(FrameContext& ctx, const Lighting& lighting, double angular_diameter_rad,
-                                            std::vector<const RenderObject*>& drawn) {
+                                            std::vector<const UploadedObject*>& drawn) {
   const auto start = std::chrono::steady_clock::now();
   const auto skip = [&](std::string why) -> const ShadowLookup* {
     ctx.record_timing("shadow", milliseconds_since(start), std::move(why));
@@ -308,9 +308,9 @@ const ShadowLookup* RenderStage::shadow_for(FrameContext& ctx, const Lighting& l
   if (std::acos(std::clamp(dot(lighting.direction, shadow_light_direction_), -1.0, 1.0)) > kShadowLightStepRad)
     shadow_light_direction_ = lighting.direction;
   std::vector<ShadowCaster> casters;
-  std::vector<const RenderObject*> caster_objects;
+  std::vector<const UploadedObject*> caster_objects;
   double extent = 0;
-  for (const RenderObject& object : objects_) {
+  for (const UploadedObject& object : objects_) {
     casters.push_back({object.bounds, object.T_world_object});
     caster_objects.push_back(&object);
     extent = std::max(extent, norm(object.bounds.max - object.bounds.min));
@@ -322,7 +322,7 @@ const ShadowLookup* RenderStage::shadow_for(FrameContext& ctx, const Lighting& l
           ? fit_local_shadow_frustum(lighting.position, casters, settings_.shadows.receiver_height_m, margin)
           : fit_shadow_frustum(shadow_light_direction_, casters, settings_.shadows.receiver_height_m, margin);
   if (!frustum) return skip(lighting.local ? "lamp not above the objects" : "light below the ground");
-  const RenderObject& catcher = receiver_->over(frustum->receiver);
+  const UploadedObject& catcher = receiver_->over(frustum->receiver);
   // Variance maps also hold the ground, so that filtering across an object's edge blends its depth
   // with the ground's rather than with empty space.
   if (is_variance_method(settings_.shadow_method)) caster_objects.push_back(&catcher);

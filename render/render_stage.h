@@ -8,15 +8,15 @@
 #include <vector>
 
 #include "core/pipeline/stage.h"
-#include "render/lens_mode.h"
-#include "render/lens_warp_map.h"
-#include "render/lens_warp_pass.h"
-#include "render/motion_blur.h"
-#include "render/per_model_cache.h"
-#include "render/render_objects.h"
+#include "render/lens/lens_mode.h"
+#include "render/lens/lens_warp_map.h"
+#include "render/lens/lens_warp_pass.h"
+#include "render/blur/motion_blur.h"
+#include "render/lens/per_model_cache.h"
+#include "render/uploaded_objects.h"
 #include "render/render_session.h"
-#include "render/shadow_map.h"
-#include "render/shadow_receiver.h"
+#include "render/shadow/shadow_map.h"
+#include "render/shadow/shadow_receiver.h"
 
 namespace arpipe {
 
@@ -64,7 +64,7 @@ class RenderStage final : public Stage {
   Lighting frame_lighting(const FrameContext& ctx, double& angular_diameter_rad) const;
   // The shadow map for this frame's light, or nullptr (ctx gets a "shadow" timing saying why).
   const ShadowLookup* shadow_for(FrameContext& ctx, const Lighting& lighting, double angular_diameter_rad,
-                                 std::vector<const RenderObject*>& drawn);
+                                 std::vector<const UploadedObject*>& drawn);
   std::shared_ptr<const LensWarpMap> warp_map(const std::shared_ptr<const CameraModel>& camera_model);
   std::shared_ptr<const CameraModel> pinhole_core(const std::shared_ptr<const CameraModel>& camera_model);
 
@@ -76,7 +76,7 @@ class RenderStage final : public Stage {
   Vec3 shadow_light_direction_{0, 0, 0};  // what the shadow map was made for (moves in steps)
   PerModelCache<LensWarpMap> warp_maps_;
   PerModelCache<CameraModel> pinhole_cores_;  // render.lens = "undistort": what the output sees
-  std::vector<RenderObject> objects_;
+  std::vector<UploadedObject> objects_;
   Settings settings_;
   std::string last_error_;  // logged once per distinct message, not once per frame
 };

@@ -8,7 +8,7 @@
 
 #include "core/geometry/se3.h"
 #include "core/motion/shutter_motion.h"
-#include "render/gl_program.h"
+#include "render/gl/gl_program.h"
 
 namespace arpipe {
 

@@ -5,7 +5,7 @@
 #include <algorithm>
 
 #include "core/log.h"
-#include "render/gl_error.h"
+#include "render/gl/gl_error.h"
 
 namespace arpipe {
 

@@ -2,8 +2,8 @@
 // alpha, at the camera's size, multisampled when asked and resolved into a texture to composite.
 #pragma once
 
-#include "render/egl_context.h"
-#include "render/gl_objects.h"
+#include "render/gl/egl_context.h"
+#include "render/gl/gl_objects.h"
 #include "render/pixel_rect.h"
 
 namespace arpipe {

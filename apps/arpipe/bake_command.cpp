@@ -11,7 +11,7 @@
 
 #include "apps/arpipe/commands.h"
 #include "apps/arpipe/progress_bar.h"
-#include "core/light/sh_basis.h"
+#include "core/sh/sh_basis.h"
 #include "core/scene/asset_error.h"
 #include "core/scene/builtin_meshes.h"
 #include "core/scene/gltf_loader.h"

@@ -26,7 +26,7 @@
 #include "core/image/image_quality.h"
 #include "core/image/pixel_convert.h"
 #include "core/log.h"
-#include "render/render_stages.h"
+#include "render/gl_stages.h"
 
 namespace arpipe {
 namespace {
@@ -72,7 +72,7 @@ struct Rendered {
 class VariantRenderer {
  public:
   VariantRenderer(const Config& base, const Variant& variant, const std::shared_ptr<const CameraModel>& camera_model)
-      : stages_(make_render_stages()) {
+      : stages_(make_gl_stages()) {
     Config config = base;
     config.render.blur.method = variant.method;
     config.render.blur.samples = variant.samples;

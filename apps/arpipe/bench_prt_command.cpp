@@ -15,7 +15,7 @@
 
 #include "apps/arpipe/commands.h"
 #include "apps/arpipe/prt_runtime_cost.h"
-#include "core/light/sh_basis.h"
+#include "core/sh/sh_basis.h"
 #include "render/prt/prt_bake.h"
 #include "render/prt/prt_test_meshes.h"
 

@@ -17,10 +17,10 @@
 
 #include "apps/arpipe/commands.h"
 #include "core/geometry/vec.h"
-#include "core/light/sh_basis.h"
-#include "core/light/sh_irradiance.h"
-#include "core/light/sh_sampling.h"
-#include "core/light/sh_window.h"
+#include "core/sh/sh_basis.h"
+#include "core/sh/sh_irradiance.h"
+#include "core/sh/sh_sampling.h"
+#include "core/sh/sh_window.h"
 
 namespace arpipe {
 namespace {

@@ -14,7 +14,7 @@
 #include "core/geometry/camera_model.h"
 #include "core/pipeline/frame_context.h"
 #include "core/scene/builtin_meshes.h"
-#include "render/render_stages.h"
+#include "render/gl_stages.h"
 
 namespace arpipe {
 namespace {
@@ -73,7 +73,7 @@ void print_prt_runtime_cost(int frames) {
              "Lambert |\n|---|---|---|---|---|\n",
              kWidth, kHeight, frames);
   for (const std::string mesh : {"builtin:sphere", "builtin:cup"}) {
-    Variant variants[2] = {{"off", make_render_stages(), {}}, {"shadowed", make_render_stages(), {}}};
+    Variant variants[2] = {{"off", make_gl_stages(), {}}, {"shadowed", make_gl_stages(), {}}};
     for (Variant& v : variants)
       for (auto& stage : v.stages) stage->configure(scene(mesh, v.prt, cache_dir));
     for (int frame = -3; frame < frames; ++frame)

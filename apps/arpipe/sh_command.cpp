@@ -15,12 +15,12 @@
 #include "core/image/radiance_hdr.h"
 #include "core/image/reinhard_tone_map.h"
 #include "core/image/srgb.h"
-#include "core/light/environment_sh.h"
-#include "core/light/hdr_environment.h"
-#include "core/light/probe_layout.h"
-#include "core/light/sh_irradiance.h"
-#include "core/light/sh_sampling.h"
-#include "core/light/sh_window.h"
+#include "core/environment/environment_sh.h"
+#include "core/environment/hdr_environment.h"
+#include "core/environment/environment_layout.h"
+#include "core/sh/sh_irradiance.h"
+#include "core/sh/sh_sampling.h"
+#include "core/sh/sh_window.h"
 #include "core/scene/asset_error.h"
 
 #include <opencv2/imgcodecs.hpp>
@@ -74,7 +74,7 @@ HdrImage reconstruct(const HdrEnvironment& environment, const ShRgb& sh, const M
   out.rgb.assign(size_t(out.width) * size_t(out.height) * 3, 0.0f);
   for (int y = 0; y < out.height; ++y)
     for (int x = 0; x < out.width; ++x) {
-      const std::optional<Vec3> probe_dir = probe_pixel_direction(environment.layout(), out.width, out.height, x, y);
+      const std::optional<Vec3> probe_dir = environment_pixel_direction(environment.layout(), out.width, out.height, x, y);
       if (!probe_dir) continue;
       const Vec3 radiance = sh_eval(sh, mat_mul(R_world_probe, *probe_dir));
       for (size_t c = 0; c < 3; ++c)
@@ -147,7 +147,7 @@ int run_sh(const Args& args) {
   }
   if (probe_file.empty()) return usage_error("--probe FILE is required");
   if (layout_name.empty()) return usage_error("--layout is required");
-  const std::optional<ProbeLayout> layout = parse_probe_layout(layout_name);
+  const std::optional<EnvironmentLayout> layout = parse_environment_layout(layout_name);
   if (!layout) return usage_error(fmt::format("--layout: expected angular, mirror-ball, equirect or cube-cross, got \"{}\"", layout_name));
   const std::optional<ShWindow> window = parse_sh_window(window_name);
   if (!window) return usage_error(fmt::format("--window: expected none, hanning or lanczos, got \"{}\"", window_name));
@@ -171,7 +171,7 @@ int run_sh(const Args& args) {
     const double ms = 1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     apply_sh_window(sh, *window);
     fmt::print("probe {} ({} x {}, {}), scale {}, yaw {} deg\n", probe_file, environment.width(), environment.height(),
-               probe_layout_name(*layout), scale, yaw_deg);
+               environment_layout_name(*layout), scale, yaw_deg);
     fmt::print("radiance SH, {} bands, {} ({:.1f} ms), window {}\n", bands,
                method == "texels" ? std::string("per-texel solid angles") : fmt::format("{0} x {0} jittered samples", samples),
                ms, window_name);

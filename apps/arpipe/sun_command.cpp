@@ -12,11 +12,11 @@
 
 #include "apps/arpipe/commands.h"
 #include "apps/arpipe/parse_number.h"
-#include "core/light/civil_time.h"
-#include "core/light/delta_t.h"
-#include "core/light/sun_direction.h"
-#include "core/light/sun_position_psa.h"
-#include "core/light/sun_position_spa.h"
+#include "core/sun/civil_time.h"
+#include "core/sun/delta_t.h"
+#include "core/sun/sun_direction.h"
+#include "core/sun/sun_position_psa.h"
+#include "core/sun/sun_position_spa.h"
 
 namespace arpipe {
 

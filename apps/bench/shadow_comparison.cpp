@@ -11,7 +11,7 @@
 #include "capture/sim/sim_scene_loader.h"
 #include "core/image/srgb.h"
 #include "core/pipeline/frame_context.h"
-#include "render/render_stages.h"
+#include "render/gl_stages.h"
 
 namespace arpipe::bench {
 namespace {
@@ -107,7 +107,7 @@ ShadowComparison compare_shadow(const std::filesystem::path& scenes_dir, const S
                                 const std::string& method, int map_size, int frames) {
   const sim::SimScene scene = sim::load_sim_scene(scenes_dir / setup.file);
   auto camera = std::make_shared<const CameraModel>(scene.camera.model);
-  std::vector<std::unique_ptr<Stage>> stages = make_render_stages();
+  std::vector<std::unique_ptr<Stage>> stages = make_gl_stages();
   Config config = shadow_config(setup, method, map_size);
   const Config turned = [&] {
     // 0.1 degree about z: past the map's 0.05 degree step, a shadow 5 cm long moves 0.1 mm.

@@ -11,8 +11,8 @@
 #include "core/light/light_stage.h"
 #include "core/motion/motion_stage.h"
 #include "core/track/tag_tracker.h"
-#include "render/lens_mode.h"
-#include "render/render_stages.h"
+#include "render/lens/lens_mode.h"
+#include "render/gl_stages.h"
 
 namespace arpipe {
 
@@ -44,7 +44,7 @@ StageFactory make_stage_factory(const Config& config) {
     stages.push_back(std::make_unique<TagTracker>());
     if (motion) stages.push_back(std::make_unique<MotionStage>());
     if (light) stages.push_back(std::make_unique<LightStage>());
-    for (auto& stage : make_render_stages()) stages.push_back(std::move(stage));
+    for (auto& stage : make_gl_stages()) stages.push_back(std::move(stage));
     return stages;
   };
 }

@@ -7,7 +7,7 @@
 #include <optional>
 #include <stdexcept>
 
-#include "core/light/environment_light.h"
+#include "core/environment/environment_light.h"
 #include "core/log.h"
 #include "core/pipeline/monotonic_clock.h"
 

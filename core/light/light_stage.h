@@ -8,8 +8,8 @@
 #include <string>
 
 #include "core/light/ground_radiance.h"
-#include "core/light/probe_light_estimator.h"
-#include "core/light/sun_light.h"
+#include "core/probe/probe_light_estimator.h"
+#include "core/sun/sun_light.h"
 #include "core/pipeline/stage.h"
 
 namespace arpipe {

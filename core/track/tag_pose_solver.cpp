@@ -56,7 +56,7 @@ double polygon_area(const std::array<cv::Point2d, 4>& p) {
 }
 
 // Both IPPE_SQUARE solutions of one tag, as T_cam_world.
-std::vector<SE3> ippe_square_seeds(const UndistortedTag& seed) {
+std::vector<SE3> ippe_square_candidates(const UndistortedTag& seed) {
   double edge = 0;
   const SE3 T_world_tag = square_pose_in_world(seed.tag->world, edge);
   // IPPE_SQUARE wants its corners in AprilTag's own frame (x right, y down, z into the tag), which is
@@ -130,7 +130,7 @@ std::optional<TagPoseSolution> solve(const CameraModel& camera, const std::vecto
   // The largest tag gives the best-conditioned seeds; fall back to the next when IPPE fails.
   std::vector<SE3> seeds;
   for (const auto& tag : usable) {
-    seeds = ippe_square_seeds(tag);
+    seeds = ippe_square_candidates(tag);
     if (!seeds.empty()) break;
   }
 

@@ -17,7 +17,7 @@
 #include <thread>
 #include <vector>
 
-#include "core/light/sh_sampling.h"
+#include "core/sh/sh_sampling.h"
 #include "core/scene/asset_error.h"
 #include "render/prt/prt_ray_scene.h"
 

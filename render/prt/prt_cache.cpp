@@ -22,7 +22,7 @@
 #include <string_view>
 #include <system_error>
 
-#include "core/light/sh_basis.h"
+#include "core/sh/sh_basis.h"
 #include "render/prt/prt_bake.h"
 
 namespace arpipe {

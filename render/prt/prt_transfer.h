@@ -12,7 +12,7 @@
 namespace arpipe {
 
 // Convention. A surface of albedo rho at vertex v, lit by distant radiance whose SH coefficients
-// are L_i in the OBJECT frame (real SH, core/light/sh_basis.h), leaves with radiance
+// are L_i in the OBJECT frame (real SH, core/sh/sh_basis.h), leaves with radiance
 //   L_out(v) = rho * sum_i L_i T_i(v),   T_i(v) = (1/pi) * integral y_i(w) V(v, w) max(0, n.w) dw.
 // The Lambertian 1/pi (rho/pi is the BRDF) is folded into T, the albedo is not: it is applied at run
 // time per mesh part, so one scalar vector per vertex serves every colour channel. Unshadowed

@@ -5,7 +5,7 @@
 
 #include <cstdio>
 
-#include "core/light/sh_basis.h"
+#include "core/sh/sh_basis.h"
 #include "render/prt/prt_bake.h"
 #include "render/prt/prt_test_meshes.h"
 #include "tests/prt/prt_test_support.h"

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "core/light/sh_basis.h"
+#include "core/sh/sh_basis.h"
 #include "core/scene/builtin_meshes.h"
 #include "render/prt/prt_bake.h"
 #include "tests/prt/prt_test_support.h"

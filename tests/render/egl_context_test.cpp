@@ -1,11 +1,11 @@
 // Tests of the headless EGL context: each platform this EGL offers comes up with a GLES 3 context,
 // and a request that cannot be met fails with a message saying what was tried.
-#include "render/egl_context.h"
+#include "render/gl/egl_context.h"
 
 #include <GLES3/gl3.h>
 #include <gtest/gtest.h>
 
-#include "render/render_errors.h"
+#include "render/gl/render_errors.h"
 
 namespace arpipe {
 namespace {

@@ -1,13 +1,13 @@
 // Tests of the GLSL program helper: a shader that does not compile, a program that does not link
 // and a missing uniform each throw RenderError naming the program, with the driver's log.
-#include "render/gl_program.h"
+#include "render/gl/gl_program.h"
 
 #include <gtest/gtest.h>
 
 #include <functional>
 
-#include "render/egl_context.h"
-#include "render/render_errors.h"
+#include "render/gl/egl_context.h"
+#include "render/gl/render_errors.h"
 
 namespace arpipe {
 namespace {

@@ -6,8 +6,8 @@
 
 #include <vector>
 
-#include "render/gl_error.h"
-#include "render/gl_objects.h"
+#include "render/gl/gl_error.h"
+#include "render/gl/gl_objects.h"
 
 namespace arpipe::render_test {
 

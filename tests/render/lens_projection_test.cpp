@@ -1,7 +1,7 @@
 // Tests of the vertex-shader projection: the GL clip positions it computes, captured with
 // transform feedback and mapped to pixels by GL's viewport rule, against CameraModel::project
 // (mrcal) for PINHOLE and OPENCV4/5/8; and unsupported lens models are refused by name.
-#include "render/lens_projection.h"
+#include "render/lens/lens_projection.h"
 
 #include <GLES3/gl3.h>
 #include <gtest/gtest.h>
@@ -12,9 +12,9 @@
 #include <cstring>
 #include <random>
 
-#include "render/egl_context.h"
-#include "render/gl_objects.h"
-#include "render/render_errors.h"
+#include "render/gl/egl_context.h"
+#include "render/gl/gl_objects.h"
+#include "render/gl/render_errors.h"
 
 namespace arpipe {
 namespace {

@@ -1,7 +1,7 @@
 // Tests of the camera-frame undistortion (render.lens = "undistort") against an independent
 // computation: every output pixel is the camera frame sampled bilinearly in linear light where
 // mrcal projects the pinhole core's ray; black where the lens does not see; a pinhole copies.
-#include "render/lens_undistortion.h"
+#include "render/lens/lens_undistortion.h"
 
 #include <gtest/gtest.h>
 

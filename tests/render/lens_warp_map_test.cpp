@@ -2,7 +2,7 @@
 // canvas and carried back through the inverted map land where CameraModel::project (mrcal) puts
 // them, for a strongly distorted OPENCV8 lens and a splined model; the canvas holds every ray;
 // pinhole lenses need no warp; lenses a pinhole canvas cannot hold are refused by name.
-#include "render/lens_warp_map.h"
+#include "render/lens/lens_warp_map.h"
 
 #include <gtest/gtest.h>
 
@@ -14,7 +14,7 @@
 #include <memory>
 #include <random>
 
-#include "render/render_errors.h"
+#include "render/gl/render_errors.h"
 
 namespace arpipe {
 namespace {

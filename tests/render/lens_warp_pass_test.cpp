@@ -1,7 +1,7 @@
 // Tests of the lens warp's GL pass: a canvas whose texels hold their own coordinates, warped,
 // must give every lens pixel its map value (orientation, pixel centres and bilinear sampling all
 // checked at once), only inside the rectangle asked for; and the pass's cost at 640x480.
-#include "render/lens_warp_pass.h"
+#include "render/lens/lens_warp_pass.h"
 
 #include <GLES3/gl3.h>
 #include <gtest/gtest.h>
@@ -10,8 +10,8 @@
 #include <chrono>
 #include <iostream>
 
-#include "render/egl_context.h"
-#include "render/gl_error.h"
+#include "render/gl/egl_context.h"
+#include "render/gl/gl_error.h"
 #include "tests/render/gl_readback.h"
 
 namespace arpipe {

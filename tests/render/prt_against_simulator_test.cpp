@@ -13,9 +13,9 @@
 #include "capture/sim/sample_rng.h"
 #include "capture/sim/scene_shader.h"
 #include "core/image/radiance_hdr.h"
-#include "core/light/environment_light.h"
-#include "core/light/hdr_environment.h"
-#include "core/light/probe_layout.h"
+#include "core/environment/environment_light.h"
+#include "core/environment/hdr_environment.h"
+#include "core/environment/environment_layout.h"
 #include "core/scene/builtin_meshes.h"
 #include "render_test_support.h"
 
@@ -62,7 +62,7 @@ const SkyFiles& sky_files() {
       for (int x = 0; x < W; ++x) {
         const double phi = 2 * std::numbers::pi * (x + 0.5) / W, theta = std::numbers::pi * (y + 0.5) / H;
         const Vec3 sim_dir{std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)};
-        const Vec3 our_dir = mat_mul(R_world_probe, *probe_pixel_direction(ProbeLayout::Equirectangular, W, H, x, y));
+        const Vec3 our_dir = mat_mul(R_world_probe, *environment_pixel_direction(EnvironmentLayout::Equirectangular, W, H, x, y));
         const Vec3 a = environment_radiance(sim_dir), b = environment_radiance(our_dir);
         for (size_t c = 0; c < 3; ++c) {
           sim.rgb[(size_t(y) * W + x) * 3 + c] = float(a[c]);

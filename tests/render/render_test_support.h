@@ -16,7 +16,7 @@
 #include "core/geometry/se3.h"
 #include "core/pipeline/frame_context.h"
 #include "core/pipeline/stage.h"
-#include "render/render_stages.h"
+#include "render/gl_stages.h"
 
 namespace arpipe::render_test {
 
@@ -165,7 +165,7 @@ inline std::vector<PixelTruth> classify_image(const CameraModel& camera, const S
 // The render and composite stages, configured once per config.
 class StageHarness {
  public:
-  StageHarness() : stages_(make_render_stages()) {}
+  StageHarness() : stages_(make_gl_stages()) {}
   void configure(const Config& config) {
     for (auto& stage : stages_) stage->configure(config);
   }

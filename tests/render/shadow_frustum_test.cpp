@@ -1,11 +1,11 @@
-// The shadow map's fitted light view (render/shadow_frustum.h): every caster corner and the
+// The shadow map's fitted light view (render/shadow/shadow_frustum.h): every caster corner and the
 // receiver patch inside the map, the patch holding each corner's shadow, the GL matrix agreeing
 // with the CPU mapping, for a directional light and for a lamp.
 #include <gtest/gtest.h>
 
 #include <vector>
 
-#include "render/shadow_frustum.h"
+#include "render/shadow/shadow_frustum.h"
 
 namespace arpipe {
 namespace {

@@ -3,7 +3,7 @@
 // X - v u (u in [-1/2, 1/2]) inside the square's pixel extent: ramps of length |v|. Also: no
 // motion leaves the input, alpha is conserved, opposite motions, a nearer static surface hides
 // what passes behind it, only rect is written; and the cost at 640x480.
-#include "render/velocity_blur_pass.h"
+#include "render/blur/velocity_blur_pass.h"
 
 #include <GLES3/gl3.h>
 #include <gtest/gtest.h>
@@ -15,8 +15,8 @@
 #include <iostream>
 #include <vector>
 
-#include "render/egl_context.h"
-#include "render/gl_error.h"
+#include "render/gl/egl_context.h"
+#include "render/gl/gl_error.h"
 #include "tests/render/gl_readback.h"
 
 namespace arpipe {

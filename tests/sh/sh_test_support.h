@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "core/geometry/vec.h"
-#include "core/light/sh_basis.h"
-#include "core/light/sh_sampling.h"
+#include "core/sh/sh_basis.h"
+#include "core/sh/sh_sampling.h"
 
 namespace arpipe::sh_test {
 

@@ -1,0 +1,156 @@
+// Draws one frame's virtual objects, sharp or motion blurred (see motion_blur.h).
+#include "render/blur/motion_blur.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "core/motion/intraframe_warp_plan.h"
+#include "render/gl/gl_error.h"
+
+namespace arpipe {
+namespace {
+
+// Automatic sample counts: about one per pixel of image motion, so neighbouring samples overlap
+// (gaps would show as separate ghosts), within what each method can afford.
+constexpr int kMaxAutoAccumulateSamples = 64;
+constexpr int kMaxAutoVelocityTaps = 32;
+
+int samples_for_motion(double motion_px, int lowest, int highest) {
+  return std::clamp(static_cast<int>(std::ceil(motion_px)), lowest, highest);
+}
+
+std::array<Vec3, 8> box_corners(const Bounds& box) {
+  std::array<Vec3, 8> out{};
+  for (int i = 0; i < 8; ++i)
+    out[i] = {(i & 1) ? box.max[0] : box.min[0], (i & 2) ? box.max[1] : box.min[1], (i & 4) ? box.max[2] : box.min[2]};
+  return out;
+}
+
+std::vector<ObjectAtInstant> objects_at(const LayerDrawRequest& request, double exposure_fraction) {
+  static const ShutterMotion kNoMotion;
+  const ShutterMotion& motion = request.motion ? *request.motion : kNoMotion;
+  std::vector<ObjectAtInstant> out;
+  out.reserve(request.objects.size());
+  for (const UploadedObject* object : request.objects)
+    out.push_back({object, row_poses(motion, request.T_cam_world, object->T_world_object, exposure_fraction,
+                                     request.rolling_shutter)});
+  return out;
+}
+
+}  // namespace
+
+BlurMethod parse_blur_method(std::string_view name) {
+  if (name == "off") return BlurMethod::Off;
+  if (name == "accumulate") return BlurMethod::Accumulate;
+  if (name == "seed") return BlurMethod::Seed;
+  if (name == "velocity") return BlurMethod::Velocity;
+  throw ConfigError(fmt::format("render.blur.method: expected \"off\", \"accumulate\", \"seed\" or \"velocity\", got \"{}\"", name));
+}
+
+std::string_view blur_method_name(BlurMethod method) {
+  switch (method) {
+    case BlurMethod::Off: return "off";
+    case BlurMethod::Accumulate: return "accumulate";
+    case BlurMethod::Seed: return "seed";
+    case BlurMethod::Velocity: return "velocity";
+  }
+  return "?";
+}
+
+MotionBlurDrawer::MotionBlurDrawer(const EglContext& context, GLenum layer_format)
+    : context_(context), layer_format_(layer_format) {}
+
+void MotionBlurDrawer::prepare(BlurMethod method) {
+  if (method == BlurMethod::Accumulate && !accumulation_) accumulation_ = std::make_unique<AccumulationPass>(context_);
+  if (method == BlurMethod::Seed && !seed_) seed_ = std::make_unique<IntraframeWarpBlurPass>(layer_format_);
+  if (method == BlurMethod::Velocity && !velocity_) velocity_ = std::make_unique<VelocityBlurPass>(layer_format_);
+}
+
+void MotionBlurDrawer::draw_at(VirtualLayer& layer, const LayerDrawRequest& request, double exposure_fraction) {
+  layer.begin(request.rect);
+  const std::vector<ObjectAtInstant> objects = objects_at(request, exposure_fraction);
+  objects_.draw(request.lens, request.rows, request.lighting, objects);
+  layer.resolve(request.rect);
+}
+
+LayerDrawResult MotionBlurDrawer::draw(VirtualLayer& layer, const LayerDrawRequest& request, const BlurConfig& config) {
+  layer.ensure(request.lens.width, request.lens.height, request.msaa_samples);
+  const BlurMethod method = parse_blur_method(config.method);
+  LayerDrawResult result;
+  if (method != BlurMethod::Off) {
+    if (!request.motion || !request.motion->valid()) result.sharp_because = "no motion estimate";
+    else if (request.image_motion_px < config.min_motion_px) result.sharp_because = "motion below render.blur.min_motion_px";
+  }
+  if (method != BlurMethod::Off && result.sharp_because.empty()) {
+    prepare(method);
+    switch (method) {
+      case BlurMethod::Accumulate:
+        return draw_accumulated(layer, request,
+                                config.samples > 0 ? config.samples
+                                                   : samples_for_motion(request.image_motion_px, 2, kMaxAutoAccumulateSamples));
+      case BlurMethod::Seed: return draw_intraframe_warp(layer, request, config.samples);
+      case BlurMethod::Velocity:
+        return draw_velocity(layer, request,
+                             config.samples > 0 ? std::min(config.samples, VelocityBlurPass::kMaxSamples)
+                                                : samples_for_motion(request.image_motion_px, 4, kMaxAutoVelocityTaps));
+      case BlurMethod::Off: break;
+    }
+  }
+  // Sharp: each row at the middle of its own exposure.
+  draw_at(layer, request, 0.5);
+  result.texture = layer.texture();
+  return result;
+}
+
+LayerDrawResult MotionBlurDrawer::draw_accumulated(VirtualLayer& layer, const LayerDrawRequest& request, int samples) {
+  accumulation_->begin(layer.width(), layer.height(), request.rect);
+  const float weight = 1.0f / static_cast<float>(samples);
+  for (int k = 0; k < samples; ++k) {
+    // Midpoints of equal slices: a box filter over the shutter interval.
+    draw_at(layer, request, (k + 0.5) / samples);
+    accumulation_->add(layer.texture(), request.rect, weight);
+  }
+  return {accumulation_->texture(), BlurMethod::Accumulate, samples, {}};
+}
+
+LayerDrawResult MotionBlurDrawer::draw_intraframe_warp(VirtualLayer& layer, const LayerDrawRequest& request, int fixed_samples) {
+  // The box corners of every object, tracked on the canvas: one affine warp serves all objects,
+  // which is exact for one object and close for objects near each other.
+  const CornerTrack corners_at = [&](double t) {
+    std::vector<std::optional<Vec2>> out;
+    for (const ObjectAtInstant& item : objects_at(request, t))
+      for (const Vec3& corner : box_corners(item.object->bounds))
+        out.push_back(request.canvas_camera->project(item.poses.camera_point(corner, request.rows)));
+    return out;
+  };
+  const IntraframeWarpPlan plan = plan_intraframe_warp_blur(corners_at, fixed_samples);
+  if (plan.samples.empty()) {
+    draw_at(layer, request, 0.5);
+    return {layer.texture(), BlurMethod::Off, 0, "no box corner in view"};
+  }
+  draw_at(layer, request, kFirstIntraframe);
+  first_intraframe_.ensure(layer.color_format(), layer.width(), layer.height(), false);
+  first_intraframe_.copy_from(layer.resolved_framebuffer(), request.rect);
+  draw_at(layer, request, kSecondIntraframe);
+  seed_->run(first_intraframe_.texture(), layer.texture(), layer.width(), layer.height(), plan, request.rect);
+  return {seed_->texture(), BlurMethod::Seed, static_cast<int>(plan.samples.size()), {}};
+}
+
+LayerDrawResult MotionBlurDrawer::draw_velocity(VirtualLayer& layer, const LayerDrawRequest& request, int samples) {
+  draw_at(layer, request, 0.5);
+  std::vector<ObjectOverExposure> objects;
+  const std::vector<ObjectAtInstant> start = objects_at(request, 0), mid = objects_at(request, 0.5),
+                                     end = objects_at(request, 1);
+  for (size_t i = 0; i < request.objects.size(); ++i)
+    objects.push_back({request.objects[i], start[i].poses, mid[i].poses, end[i].poses});
+  velocity_image_.ensure(GL_RGBA16F, layer.width(), layer.height(), true);
+  velocity_image_.begin(request.rect);
+  objects_.draw_velocity(request.lens, request.rows, objects);
+  velocity_->run(layer.texture(), velocity_image_.texture(), layer.width(), layer.height(), request.rect, samples);
+  return {velocity_->texture(), BlurMethod::Velocity, samples, {}};
+}
+
+}  // namespace arpipe

@@ -1,0 +1,71 @@
+// A texture to draw into (see texture_target.h).
+#include "render/gl/texture_target.h"
+
+#include "render/gl/gl_error.h"
+
+namespace arpipe {
+
+void TextureTarget::ensure(GLenum color_format, int width, int height, bool with_depth) {
+  if (texture_ && color_format == format_ && width == width_ && height == height_ && with_depth == with_depth_) return;
+  texture_ = create_texel_texture(color_format, width, height);
+  framebuffer_ = GlFramebuffer::create();
+  glBindFramebuffer(GL_FRAMEBUFFER, framebuffer_.get());
+  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture_.get(), 0);
+  depth_.reset();
+  if (with_depth) {
+    depth_ = GlRenderbuffer::create();
+    glBindRenderbuffer(GL_RENDERBUFFER, depth_.get());
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, width, height);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_.get());
+  }
+  check_framebuffer_complete("blur intermediate texture");
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  check_gl("allocating a blur intermediate texture");
+  format_ = color_format;
+  width_ = width;
+  height_ = height;
+  with_depth_ = with_depth;
+  written_ = PixelRect::full(width, height);
+}
+
+void TextureTarget::clear_outside(const PixelRect& keep) {
+  // The old rectangle and the new one usually overlap; clearing the old one whole is simpler than
+  // its difference and costs about the same.
+  if (!written_.empty() && !(written_ == keep)) {
+    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer_.get());
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(written_.x, written_.y, written_.width, written_.height);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    const GLfloat transparent[4] = {0, 0, 0, 0};
+    glClearBufferfv(GL_COLOR, 0, transparent);
+  }
+  written_ = keep;
+}
+
+void TextureTarget::begin(const PixelRect& rect) {
+  clear_outside(rect);
+  glBindFramebuffer(GL_FRAMEBUFFER, framebuffer_.get());
+  glViewport(0, 0, width_, height_);
+  glEnable(GL_SCISSOR_TEST);
+  glScissor(rect.x, rect.y, rect.width, rect.height);
+  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  const GLfloat transparent[4] = {0, 0, 0, 0};
+  glClearBufferfv(GL_COLOR, 0, transparent);
+  if (with_depth_) {
+    glDepthMask(GL_TRUE);
+    const GLfloat far_depth = 1.0f;
+    glClearBufferfv(GL_DEPTH, 0, &far_depth);
+  }
+}
+
+void TextureTarget::copy_from(GLuint read_framebuffer, const PixelRect& rect) {
+  clear_outside(rect);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, read_framebuffer);
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, framebuffer_.get());
+  glDisable(GL_SCISSOR_TEST);
+  glBlitFramebuffer(rect.x, rect.y, rect.right(), rect.bottom(), rect.x, rect.y, rect.right(), rect.bottom(),
+                    GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+}  // namespace arpipe

@@ -1,0 +1,139 @@
+// The scene's virtual objects as the render stage draws them: meshes loaded and uploaded once per
+// configure, with their placement on the anchor and their base colours.
+#include "render/uploaded_objects.h"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <stdexcept>
+
+#include "core/log.h"
+#include "core/scene/asset_error.h"
+#include "core/scene/builtin_meshes.h"
+#include "core/scene/gltf_loader.h"
+#include "render/prt/prt_cache.h"
+
+namespace arpipe {
+namespace {
+
+std::string config_name(const Config& config) {
+  return config.file.empty() ? std::string("config") : config.file.string();
+}
+
+// Errors name the config key as well as the file (the message from the loader names the file and
+// the place in it).
+Mesh load_mesh(const Config& config, size_t object_index, const std::string& source) {
+  if (is_builtin_mesh_source(source)) {
+    if (auto mesh = make_builtin_mesh(source)) return std::move(*mesh);
+    throw ConfigError(fmt::format("{}: render.objects[{}].mesh: unknown builtin mesh \"{}\" (expected "
+                                  "{} or a glTF 2.0 file)",
+                                  config_name(config), object_index, source, kBuiltinMeshNames));
+  }
+  try {
+    return load_gltf_mesh(source);  // relative to the working directory, like every path in a config
+  } catch (const std::exception& e) {
+    throw AssetError(fmt::format("{}: render.objects[{}].mesh = \"{}\": {}", config_name(config), object_index,
+                                 source, e.what()));
+  }
+}
+
+Bounds scaled(const Bounds& box, double scale) {
+  Bounds out;
+  for (size_t axis = 0; axis < 3; ++axis) {
+    const double a = box.min[axis] * scale, b = box.max[axis] * scale;
+    out.min[axis] = std::min(a, b);
+    out.max[axis] = std::max(a, b);
+  }
+  return out;
+}
+
+// The first 3 bands of the object's baked transfer (from the cache, else baked now and cached),
+// or nothing for prt = "off".
+std::vector<float> transfer_for(const Config& config, size_t object_index, const std::string& mesh_source,
+                                const Mesh& mesh, const std::string& prt) {
+  const std::optional<TransferKind> kind = parse_transfer_kind(prt);
+  if (!kind || mesh.vertex_count() == 0) return {};
+  PrtBakeSettings settings;
+  settings.kind = *kind;
+  settings.bands = config.render.prt.bands;
+  settings.samples_per_axis = config.render.prt.samples;
+  const std::filesystem::path cache_dir =
+      config.render.prt.cache_dir.empty() ? default_prt_cache_dir() : config.render.prt.cache_dir;
+  const auto start = std::chrono::steady_clock::now();
+  PrtLoad load;
+  try {
+    load = load_or_bake_prt(mesh, settings, cache_dir);
+  } catch (const std::exception& e) {
+    throw AssetError(fmt::format("{}: render.objects[{}] (mesh \"{}\", prt = \"{}\"): {}", config_name(config),
+                                 object_index, mesh_source, prt, e.what()));
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  // Baking is expected once per mesh (info); a transfer that could not be cached is baked again at
+  // every start (a warning).
+  if (load.baked)
+    log::info("prt: baked {} transfer of {} ({} vertices, {} directions) in {:.2f} s{} ({})", prt, mesh_source,
+              mesh.vertex_count(), settings.samples_per_axis * settings.samples_per_axis, seconds,
+              load.file.empty() ? std::string() : fmt::format(" into {}", load.file.string()), load.note);
+  if (load.note.find("not cached") != std::string::npos) log::warn("prt: {}: {}", mesh_source, load.note);
+  const size_t count = size_t(load.transfer.bands * load.transfer.bands);
+  std::vector<float> first9;
+  first9.reserve(9 * mesh.vertex_count());
+  for (size_t v = 0; v < load.transfer.vertex_count(); ++v)
+    for (size_t i = 0; i < 9; ++i) first9.push_back(i < count ? load.transfer.at(v)[i] : 0.0f);
+  return first9;
+}
+
+}  // namespace
+
+LoadedMeshes load_object_meshes(const Config& config) {
+  LoadedMeshes loaded;
+  std::map<std::string, size_t> index_of;  // mesh source and prt mode -> loaded.meshes
+  for (size_t i = 0; i < config.render.objects.size(); ++i) {
+    const SceneObject& object = config.render.objects[i];
+    const std::string key = object.mesh + "\n" + object.prt;
+    auto found = index_of.find(key);
+    if (found == index_of.end()) {
+      LoadedMeshes::Entry entry;
+      entry.mesh = load_mesh(config, i, object.mesh);
+      entry.transfer = transfer_for(config, i, object.mesh, entry.mesh, object.prt);
+      loaded.meshes.push_back(std::move(entry));
+      found = index_of.emplace(key, loaded.meshes.size() - 1).first;
+    }
+    loaded.mesh_of_object.push_back(found->second);
+  }
+  return loaded;
+}
+
+std::vector<UploadedObject> upload_objects(const Config& config, const LoadedMeshes& loaded) {
+  if (loaded.mesh_of_object.size() != config.render.objects.size())
+    throw std::logic_error(fmt::format("upload_objects: {} objects loaded for a config with {}",
+                                       loaded.mesh_of_object.size(), config.render.objects.size()));
+  std::vector<std::shared_ptr<const GpuMesh>> uploaded;
+  for (const LoadedMeshes::Entry& entry : loaded.meshes)
+    uploaded.push_back(std::make_shared<const GpuMesh>(entry.mesh, entry.transfer));
+  std::vector<UploadedObject> objects;
+  for (size_t i = 0; i < config.render.objects.size(); ++i) {
+    const SceneObject& object = config.render.objects[i];
+    const size_t m = loaded.mesh_of_object[i];
+    UploadedObject out;
+    out.mesh_source = object.mesh;
+    out.mesh = uploaded[m];
+    out.scale = object.scale;
+    out.specular = object.specular;
+    out.bounds = scaled(loaded.meshes[m].mesh.bounds(), object.scale);
+    out.T_world_object = SE3::from_rt({0, 0, object.yaw_rad}, object.position_m);
+    if (is_builtin_mesh_source(object.mesh))
+      out.base_color = std::array<float, 4>{static_cast<float>(object.color[0]), static_cast<float>(object.color[1]),
+                                            static_cast<float>(object.color[2]), 1.0f};
+    objects.push_back(std::move(out));
+  }
+  return objects;
+}
+
+std::vector<UploadedObject> load_and_upload_objects(const Config& config) {
+  return upload_objects(config, load_object_meshes(config));
+}
+
+}  // namespace arpipe
