@@ -12,7 +12,8 @@
 #include <optional>
 #include <stdexcept>
 
-#include "core/sh/sh9.h"
+#include "core/sh/sh_basis.h"
+#include "core/sh/sh_irradiance.h"
 #include "core/log.h"
 #include "core/pipeline/monotonic_clock.h"
 #include "render/gl/gl_error.h"
@@ -31,9 +32,6 @@ constexpr int kExposureInstants = 8;  // pieces of the exposure whose ends bound
 // frame-to-frame jitter does not redraw it every frame (a shadow 10 cm long moves 0.1 mm).
 constexpr double kRadiansPerDegree = std::numbers::pi / 180;
 constexpr double kShadowLightStepRad = 0.05 * kRadiansPerDegree;
-// Spherical-harmonic convolution with the clamped cosine (Ramamoorthi and Hanrahan), over pi:
-// ambient irradiance / pi from the radiance's coefficients, band by band.
-constexpr double kIrradianceOverPi[3] = {1.0, 2.0 / 3.0, 0.25};
 
 // What the render stage's loader reads away from the processing thread: the objects' meshes and
 // their PRT transfers, on the CPU.
@@ -285,11 +283,11 @@ Lighting RenderStage::frame_lighting(const FrameContext& ctx, double& angular_di
   // their direction (radiance coefficients E * Y_i(d)), unshadowed.
   ShRgb9 radiance_sh = light.ambient_sh;
   for (size_t k = 1; k < light.lights.size(); ++k)
-    sh9_add_sample(radiance_sh, light.lights[k].direction_world, light.lights[k].irradiance, 1.0);
-  for (size_t i = 0; i < 9; ++i) {
-    const size_t band = i == 0 ? 0 : (i < 4 ? 1 : 2);
-    lighting.ambient_sh[i] = kIrradianceOverPi[band] * radiance_sh[i];
-  }
+    sh_add_sample(radiance_sh, light.lights[k].direction_world, light.lights[k].irradiance, 1.0);
+  // Convolution with the clamped cosine (Ramamoorthi and Hanrahan), over pi: ambient irradiance / pi
+  // from the radiance's coefficients, band by band.
+  for (size_t i = 0; i < 9; ++i)
+    lighting.ambient_sh[i] = (sh_cosine_lobe_constant(sh_band(int(i))) / pi) * radiance_sh[i];
   lighting.radiance_sh = radiance_sh;
   const double exposure_s = 1e-9 * double(ctx.camera.meta.exposure_ns);
   lighting.exposure_scale = exposure_s > 0 ? exposure_s * ctx.camera.meta.total_gain() : 1.0;

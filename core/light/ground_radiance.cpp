@@ -7,6 +7,8 @@
 #include <numbers>
 #include <vector>
 
+#include "core/sh/sh_irradiance.h"
+
 namespace arpipe {
 namespace {
 
@@ -62,13 +64,12 @@ bool light_from_ground(DirectionalLight& light, const ShRgb9& ambient_sh, const 
                        const Vec3& ground_albedo) {
   const double cos_ground = light.direction_world[2];
   if (cos_ground < 0.1) return false;
-  // Irradiance on an upward surface from the ambient SH: A_l L_l0 Y_l0(up), A = pi, 2pi/3, pi/4.
+  // Irradiance on an upward surface from the ambient SH (only the zonal terms A_l L_l0 Y_l0(up) are
+  // not zero there).
+  const Vec3 ambient = sh_irradiance(from_sh9(ambient_sh), {0, 0, 1});
   Vec3 solved{};
-  for (size_t c = 0; c < 3; ++c) {
-    const double ambient = kPi * 0.282095 * ambient_sh[0][c] + (2 * kPi / 3) * 0.488603 * ambient_sh[2][c] +
-                           (kPi / 4) * 0.630784 * ambient_sh[6][c];
-    solved[c] = std::max(0.0, (kPi * ground_radiance[c] / ground_albedo[c] - ambient) / cos_ground);
-  }
+  for (size_t c = 0; c < 3; ++c)
+    solved[c] = std::max(0.0, (kPi * ground_radiance[c] / ground_albedo[c] - ambient[c]) / cos_ground);
   const auto luminance = [](const Vec3& v) { return 0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2]; };
   if (luminance(solved) <= luminance(light.irradiance)) return false;
   light.irradiance = solved;

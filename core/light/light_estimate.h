@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/geometry/vec.h"
+#include "core/sh/sh_basis.h"  // ShRgb9
 
 namespace arpipe {
 
@@ -27,9 +28,6 @@ struct DirectionalLight {
   Vec3 position_world{0, 0, 0};
 };
 
-// Real spherical harmonics, 3 bands (index l(l+1)+m, Green's convention), of the incident
-// radiance, RGB: sh[i] = integral over directions of L(w) * Y_i(w). World frame.
-using ShRgb9 = std::array<Vec3, 9>;
 
 enum class LightState {
   Estimated,   // measured on this frame (probe) or computed for its time (sun)
@@ -43,7 +41,7 @@ struct LightEstimate {
   LightState state = LightState::None;
   std::string source = "fixed";          // "fixed", "mirror-probe", "diffuse-probe" or "sun"
   std::vector<DirectionalLight> lights;  // strongest first
-  ShRgb9 ambient_sh{};                   // the light not in `lights`
+  ShRgb9 ambient_sh{};                   // the light not in `lights`: radiance SH, world frame
   bool scene_linear = false;             // units as above (false: nothing estimated yet)
   double confidence = 0;                 // [0, 1]: how far the estimate can be trusted
   int frames_since_measured = 0;         // Held: frames since the last measurement

@@ -7,7 +7,8 @@
 #include <vector>
 
 #include "core/probe/brightest_components.h"
-#include "core/sh/sh9.h"
+#include "core/sh/sh_basis.h"
+#include "core/sh/sh_irradiance.h"
 
 namespace arpipe {
 
@@ -286,13 +287,17 @@ DiffuseFitResult fit_diffuse_probe(const ProbeSphere& sphere, const ProbeRegion&
   res.light.irradiance = e;
   res.light.angular_diameter_rad = 0;
   res.ambient_constant = a0;
-  // Irradiance a0 + a.n = A_0 L_0 Y_0 + A_1 sum L_1m Y_1m(n): Y_1{-1,0,1} = c {y, z, x}.
-  const double y0 = 0.282094791773878, y1 = 0.488602511902920;
+  // Irradiance a0 + a.n = A_0 L_0 Y_0 + A_1 sum L_1m Y_1m(n): Y_0 = y0 and Y_1{-1,0,1} = y1 {y, z, x},
+  // y0 and y1 the basis at the pole.
+  std::array<double, 4> pole;
+  sh_basis(2, {0, 0, 1}, pole);
+  const double y0 = pole[size_t(sh_index(0, 0))], y1 = pole[size_t(sh_index(1, 0))];
+  const double per_a0 = 1.0 / (sh_cosine_lobe_constant(0) * y0), per_a1 = 1.0 / (sh_cosine_lobe_constant(1) * y1);
   res.ambient_sh = {};
-  res.ambient_sh[0] = (1.0 / (kPi * y0)) * a0;
-  res.ambient_sh[1] = (1.0 / (2 * kPi / 3 * y1)) * a[1];
-  res.ambient_sh[2] = (1.0 / (2 * kPi / 3 * y1)) * a[2];
-  res.ambient_sh[3] = (1.0 / (2 * kPi / 3 * y1)) * a[0];
+  res.ambient_sh[0] = per_a0 * a0;
+  res.ambient_sh[1] = per_a1 * a[1];
+  res.ambient_sh[2] = per_a1 * a[2];
+  res.ambient_sh[3] = per_a1 * a[0];
   res.ok = true;
   return res;
 }

@@ -6,7 +6,7 @@
 #include <numbers>
 
 #include "core/probe/brightest_components.h"
-#include "core/sh/sh9.h"
+#include "core/sh/sh_basis.h"
 
 namespace arpipe {
 
@@ -267,7 +267,7 @@ MirrorProbeResult analyse_mirror_probe(const ProbeSphere& sphere, const ProbeReg
   for (int j = 0; j < map.height; ++j) {
     const double omega = map.cell_solid_angle(j);
     for (int i = 0; i < map.width; ++i)
-      sh9_add_sample(res.ambient_sh, map.direction(i, j), ambient[size_t(j) * size_t(map.width) + size_t(i)], omega);
+      sh_add_sample(res.ambient_sh, map.direction(i, j), ambient[size_t(j) * size_t(map.width) + size_t(i)], omega);
   }
   return res;
 }

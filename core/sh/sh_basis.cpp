@@ -122,6 +122,12 @@ void sh_add_sample(ShRgb& sh, const Vec3& unit_dir, const Vec3& value, double we
     for (int k = 0; k < 3; ++k) sh.c[i][size_t(k)] += y[i] * v[size_t(k)];
 }
 
+void sh_add_sample(ShRgb9& sh, const Vec3& unit_dir, const Vec3& value, double weight) {
+  std::array<double, 9> y;
+  sh_basis(3, unit_dir, y);
+  for (size_t i = 0; i < 9; ++i) sh[i] = sh[i] + (y[i] * weight) * value;
+}
+
 ShRgb sh_truncated(const ShRgb& sh, int bands) {
   if (bands < 0 || bands > kMaxShBands)
     throw std::invalid_argument(fmt::format("core/sh/sh_basis.cpp: sh_truncated: bands {} outside 0..{}", bands,

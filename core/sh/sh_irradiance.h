@@ -1,9 +1,8 @@
 // Irradiance from radiance SH of any order (Ramamoorthi & Hanrahan 2001: convolution with the
-// clamped cosine is band l times A_l), and conversion to and from the 3-band ShRgb9 of sh9.h.
+// clamped cosine is band l times A_l), and conversion to and from the fixed-size 3-band ShRgb9.
 #pragma once
 
 #include "core/geometry/vec.h"
-#include "core/light/light_estimate.h"
 #include "core/sh/sh_basis.h"
 
 namespace arpipe {

@@ -4,9 +4,11 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 
+#include "core/sh/sh_basis.h"
 #include "core/sun/delta_t.h"
 #include "core/sun/sun_position_spa.h"
 
@@ -17,10 +19,15 @@ constexpr double kPi = std::numbers::pi;
 
 // SH (Green's order) of radiance `up` over the upper hemisphere and `down` below: only the
 // constant and the z term survive (the l = 2, m = 0 term integrates to zero over a hemisphere).
+// Over the upper hemisphere Y_00 = y0 integrates to 2 pi y0 and Y_10 = y1 z to pi y1, with y0 and
+// y1 the basis at the pole.
 ShRgb9 hemispheres_sh(const Vec3& up, const Vec3& down) {
+  std::array<double, 4> pole;
+  sh_basis(2, {0, 0, 1}, pole);
+  const double y0 = pole[size_t(sh_index(0, 0))], y1 = pole[size_t(sh_index(1, 0))];
   ShRgb9 sh{};
-  sh[0] = (0.282095 * 2 * kPi) * (up + down);
-  sh[2] = (0.488603 * kPi) * (up - down);
+  sh[size_t(sh_index(0, 0))] = (y0 * 2 * kPi) * (up + down);
+  sh[size_t(sh_index(1, 0))] = (y1 * kPi) * (up - down);
   return sh;
 }
 

@@ -12,7 +12,7 @@ namespace {
 namespace fs = std::filesystem;
 
 TEST(HdrCorpus, EverySeedDecodes) {
-  const fs::path corpus = fs::path(ARPIPE_SOURCE_DIR) / "tests" / "hdr" / "corpus";
+  const fs::path corpus = fs::path(ARPIPE_SOURCE_DIR) / "tests" / "environment" / "corpus";
   int seeds = 0;
   for (const auto& entry : fs::directory_iterator(corpus)) {
     const HdrImage image = read_hdr_image(entry.path());

@@ -1,5 +1,5 @@
-// Analytic checks of the probe building blocks: SH basis and Ramamoorthi-Hanrahan constants, the
-// mirror reflection, the sphere's image region, the camera response and the linear patch.
+// Analytic checks of the probe building blocks: the mirror reflection, the sphere's image region,
+// the camera response and the linear patch (the SH maths are tested in tests/sh).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -12,79 +12,11 @@
 #include "core/light/linear_patch.h"
 #include "core/probe/probe_sphere.h"
 #include "core/probe/brightest_components.h"
-#include "core/sh/sh9.h"
 
 namespace arpipe {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-
-// Midpoint quadrature on an equirectangular grid: exact to ~1e-4 for these smooth integrands.
-template <typename F>
-void for_each_direction(int w, int h, F&& f) {
-  for (int j = 0; j < h; ++j) {
-    const double theta = kPi * (j + 0.5) / h;
-    const double omega = (2 * kPi / w) * (std::cos(kPi * j / h) - std::cos(kPi * (j + 1) / h));
-    for (int i = 0; i < w; ++i) {
-      const double phi = 2 * kPi * (i + 0.5) / w;
-      f(Vec3{std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)}, omega);
-    }
-  }
-}
-
-TEST(ProbeSh9, OrthonormalByQuadrature) {
-  double gram[9][9] = {};
-  for_each_direction(256, 128, [&](const Vec3& d, double omega) {
-    const Sh9 y = sh9_basis(d);
-    for (size_t a = 0; a < 9; ++a)
-      for (size_t b = 0; b < 9; ++b) gram[a][b] += y[a] * y[b] * omega;
-  });
-  for (int a = 0; a < 9; ++a)
-    for (int b = 0; b < 9; ++b) EXPECT_NEAR(gram[a][b], a == b ? 1.0 : 0.0, 2e-4) << a << "," << b;
-}
-
-// The clamped cosine max(0, z) has zonal coefficients sqrt(pi)/2, sqrt(pi/3), sqrt(5 pi)/8, and
-// A_l = sqrt(4 pi / (2l + 1)) * coefficient_l gives Ramamoorthi & Hanrahan's pi, 2 pi/3, pi/4.
-TEST(ProbeSh9, CosineLobeAndConvolutionConstants) {
-  Sh9 c{};
-  for_each_direction(512, 256, [&](const Vec3& d, double omega) {
-    const Sh9 y = sh9_basis(d);
-    for (size_t i = 0; i < 9; ++i) c[i] += std::max(0.0, d[2]) * y[i] * omega;
-  });
-  EXPECT_NEAR(c[0], std::sqrt(kPi) / 2, 1e-4);
-  EXPECT_NEAR(c[2], std::sqrt(kPi / 3), 1e-4);
-  EXPECT_NEAR(c[6], std::sqrt(5 * kPi) / 8, 1e-4);
-  for (size_t i : {1, 3, 4, 5, 7, 8}) EXPECT_NEAR(c[i], 0, 1e-4) << i;
-  EXPECT_NEAR(std::sqrt(4 * kPi) * c[0], kPi, 1e-3);
-  EXPECT_NEAR(std::sqrt(4 * kPi / 3) * c[2], 2 * kPi / 3, 1e-3);
-  EXPECT_NEAR(std::sqrt(4 * kPi / 5) * c[6], kPi / 4, 1e-3);
-  EXPECT_DOUBLE_EQ(sh9_cosine_constant(0), kPi);
-  EXPECT_DOUBLE_EQ(sh9_cosine_constant(1), 2 * kPi / 3);
-  EXPECT_DOUBLE_EQ(sh9_cosine_constant(2), kPi / 4);
-}
-
-// For a radiance of bands 0-2 the SH irradiance is exact (the clamped cosine's higher bands are
-// orthogonal to it): compare with the brute-force integral of L(w) max(0, n.w).
-TEST(ProbeSh9, IrradianceOfBandLimitedRadianceIsExact) {
-  std::mt19937 rng(3);
-  std::uniform_real_distribution<double> u(-1, 1);
-  ShRgb9 sh{};
-  for (Vec3& c : sh) c = {u(rng), u(rng), u(rng)};
-  sh[0] = sh[0] + Vec3{4, 4, 4};
-  for (const Vec3 n : {Vec3{0, 0, 1}, Vec3{0, 0, -1}, normalized(Vec3{1, -2, 0.5}), normalized(Vec3{-0.3, 0.2, -1})}) {
-    Vec3 brute{0, 0, 0};
-    for_each_direction(512, 256, [&](const Vec3& d, double omega) {
-      brute = brute + (std::max(0.0, dot(n, d)) * omega) * sh9_eval(sh, d);
-    });
-    const Vec3 e = sh9_irradiance(sh, n);
-    for (size_t k = 0; k < 3; ++k) EXPECT_NEAR(e[k], brute[k], 2e-3 * std::abs(brute[k]) + 1e-3);
-  }
-  // A constant radiance L gives pi L on every surface.
-  const ShRgb9 flat = sh9_constant({2, 3, 4});
-  const Vec3 e = sh9_irradiance(flat, normalized(Vec3{0.3, 0.4, -0.5}));
-  EXPECT_NEAR(e[0], 2 * kPi, 1e-9);
-  EXPECT_NEAR(e[2], 4 * kPi, 1e-9);
-}
 
 TEST(ProbeReflection, AnalyticCases) {
   const Vec3 r = reflect(normalized(Vec3{1, -1, 0}), {0, 1, 0});

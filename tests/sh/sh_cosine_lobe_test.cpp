@@ -4,7 +4,6 @@
 #include <cmath>
 #include <numbers>
 
-#include "core/sh/sh9.h"
 #include "core/sh/sh_irradiance.h"
 #include "core/sh/sh_sampling.h"
 
@@ -20,7 +19,6 @@ TEST(ShCosineLobe, ClosedFormValues) {
   EXPECT_EQ(sh_cosine_lobe_constant(3), 0.0);
   EXPECT_DOUBLE_EQ(sh_cosine_lobe_constant(4), -kPi / 24);
   EXPECT_DOUBLE_EQ(sh_cosine_lobe_constant(6), kPi / 64);  // 2 pi / (8 * 5) * 20 / 64
-  for (int l = 0; l < 3; ++l) EXPECT_DOUBLE_EQ(sh_cosine_lobe_constant(l), sh9_cosine_constant(l));
 }
 
 TEST(ShCosineLobe, ProjectionMatchesAl) {

@@ -1,12 +1,11 @@
 // Irradiance from radiance SH: a constant sky, a single direction (the known 3-band band-limiting
-// error), Ramamoorthi & Hanrahan's Eq. 13 on their Grace Cathedral coefficients, and sh9.h.
+// error), Ramamoorthi & Hanrahan's Eq. 13 on their Grace Cathedral coefficients.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <numbers>
 #include <random>
 
-#include "core/sh/sh9.h"
 #include "core/sh/sh_basis.h"
 #include "core/sh/sh_irradiance.h"
 
@@ -105,11 +104,9 @@ TEST(ShIrradiance, GraceCathedralMatchesEq13) {
   double worst_printed = 0;
   for (const Vec3& n : random_normals(500, 9)) {
     const Vec3 ours = sh_irradiance(sh, n), rh = rh_eq13(grace, n, printed), rh_exact = rh_eq13(grace, n, exact);
-    const Vec3 old = sh9_irradiance(grace, n);
     for (size_t k = 0; k < 3; ++k) {
       EXPECT_NEAR(ours[k], rh_exact[k], 1e-12);
       EXPECT_NEAR(ours[k], rh[k], bound[k]);
-      EXPECT_NEAR(ours[k], old[k], 1e-12);  // sh9.h: the same constants to 15 digits
       worst_printed = std::max(worst_printed, std::abs(ours[k] - rh[k]));
     }
   }
