@@ -1,6 +1,8 @@
 // arpiped's SIGHUP reloads on threads of their own (see background_reloads.h).
 #include "apps/arpiped/background_reloads.h"
 
+#include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -8,8 +10,10 @@
 #include <exception>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "apps/arpiped/log_level.h"
+#include "apps/arpiped/reload_changes.h"
 #include "core/log.h"
 #include "core/pipeline/pipeline_runner.h"
 
@@ -59,22 +63,33 @@ void BackgroundReloads::reload(const std::shared_ptr<Shared>& s, uint64_t ticket
   const std::string path = s->options.config_path.string();
   std::string error;
   bool accepted = false;
+  std::vector<std::string> applied;
   try {
     Config next = load_config(s->options.config_path, s->options.overrides);
-    if (next.source != s->started.source || next.pipeline.queue_depth != s->started.pipeline.queue_depth)
-      log::warn("{}: source and pipeline changes take effect at the next restart; stages and lighting now", path);
-    accepted = s->reloader->reconfigure(ticket, next, error, PipelineRunner::kReconfigureBoundaryTimeout);
-    if (accepted) log::set_max_level(log_level_from_name(next.pipeline.log_level));
+    // Refused whole, before anything is loaded: applying the rest would leave a config running
+    // that is neither the old one nor the file's.
+    if (const std::vector<std::string> restart = keys_needing_restart(s->started, next); !restart.empty()) {
+      error = fmt::format("{} {} a restart", fmt::join(restart, ", "), restart.size() == 1 ? "needs" : "need");
+    } else {
+      Config replaced;
+      accepted = s->reloader->reconfigure(ticket, next, error, PipelineRunner::kReconfigureBoundaryTimeout, &replaced);
+      if (accepted) {
+        applied = changed_parts(replaced, next);
+        log::set_max_level(log_level_from_name(next.pipeline.log_level));
+      }
+    }
   } catch (const std::exception& e) {
     error = e.what();
   }
   const bool newest = s->newest_ticket.load() == ticket;
-  if (accepted)
-    log::info("reload accepted");
+  if (accepted && applied.empty())
+    log::info("reload applied: no key changed; the stages read their files again");
+  else if (accepted)
+    log::info("reload applied: {}", fmt::join(applied, ", "));
   else if (error == StageReloader::kSuperseded)
     log::info("reload of {} superseded by a newer SIGHUP: not applied", path);
   else
-    log::error("reload refused, the running config stays: {}", error);
+    log::error("reload refused: {}; the running config stays", error);
   if (newest) s->systemd.ready();
   --s->running;  // last: the daemon may _exit from here on
 }

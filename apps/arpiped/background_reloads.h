@@ -15,12 +15,14 @@ namespace arpipe {
 
 class BackgroundReloads {
  public:
-  // started: the config the source and queues were built from (their changes need a restart).
+  // started: the config the source, queues and GL context were made from (their keys need a restart).
   BackgroundReloads(const DaemonOptions& options, const Config& started, std::shared_ptr<StageReloader> reloader,
                     SystemdNotifier systemd);
 
   // Reloads the config file on a new thread (RELOADING=1 now, READY=1 once the newest reload is
-  // answered). Logs "reload accepted", "reload refused, ..." or that a newer SIGHUP superseded it.
+  // answered). A change to a key that needs a restart refuses the whole reload, naming the key;
+  // everything else is applied (stages, light source, sinks). Logs "reload applied: " and what
+  // changed, "reload refused: " and why, or that a newer SIGHUP superseded it.
   void start();
   // Whether a reload thread is still running (stuck on a file, or baking): the daemon then leaves
   // with _exit rather than unwind what that thread may still touch.

@@ -1,5 +1,6 @@
 // The arpiped process: runs the pipeline from a config file, answers SIGTERM/SIGINT (drain and
-// flush), SIGHUP (reload; an invalid config is refused and the old one keeps running), talks to systemd.
+// flush), SIGHUP (reload: every change that can be applied while running is; an invalid config, or
+// one that changes a key needing a restart, is refused and the old one keeps running), talks to systemd.
 #pragma once
 
 #include <filesystem>

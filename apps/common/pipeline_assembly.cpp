@@ -10,6 +10,7 @@
 #include "capture/sinks/y4m_sink.h"
 #include "core/light/light_stage.h"
 #include "core/motion/motion_stage.h"
+#include "core/pipeline/optional_stage.h"
 #include "core/track/tag_tracker.h"
 #include "render/lens/lens_mode.h"
 #include "render/gl_stages.h"
@@ -23,27 +24,40 @@ std::unique_ptr<FrameSource> make_source(const Config& config) {
                                 config.file.string(), config.source.type));
 }
 
-std::vector<std::unique_ptr<FrameSink>> make_sinks(const Config& config) {
-  std::vector<std::unique_ptr<FrameSink>> sinks;
-  const auto& s = config.sinks;
-  if (s.results.enabled) sinks.push_back(std::make_unique<ResultsSink>(s.results));
-  if (s.png.enabled) sinks.push_back(std::make_unique<PngSink>(s.png));
-  if (s.y4m.enabled) sinks.push_back(std::make_unique<Y4mSink>(s.y4m));
-  if (s.recording.enabled) sinks.push_back(std::make_unique<RecordingSink>(s.recording));
-  return sinks;
+namespace {
+
+// The slot of the sink S made from the part of the config that `part` picks.
+template <typename S, typename Part>
+SinkSlot slot(std::string key, Part part) {
+  return SinkSlot{std::move(key), [part](const Config& a, const Config& b) { return part(a) == part(b); },
+                  [part](const Config& config) -> std::unique_ptr<FrameSink> {
+                    if (!part(config).enabled) return nullptr;
+                    return std::make_unique<S>(part(config));
+                  }};
 }
 
-StageFactory make_stage_factory(const Config& config) {
-  // The motion stage needs the tracker's poses. It stays out of the list when disabled (a config
-  // reload cannot add it; it can switch it off, since the stage checks motion.enabled per frame).
-  const bool motion = config.track.enabled && config.motion.enabled;
-  // Likewise the light stage: only for a probe or the sun (the fixed light needs no stage).
-  const bool light = config.light.source != "fixed";
-  return [motion, light] {
+}  // namespace
+
+std::vector<SinkSlot> sink_slots() {
+  std::vector<SinkSlot> slots;
+  slots.push_back(slot<ResultsSink>("sinks.results", [](const Config& c) -> const auto& { return c.sinks.results; }));
+  slots.push_back(slot<PngSink>("sinks.png", [](const Config& c) -> const auto& { return c.sinks.png; }));
+  slots.push_back(slot<Y4mSink>("sinks.y4m", [](const Config& c) -> const auto& { return c.sinks.y4m; }));
+  slots.push_back(slot<RecordingSink>("sinks.recording", [](const Config& c) -> const auto& { return c.sinks.recording; }));
+  return slots;
+}
+
+StageFactory make_stage_factory() {
+  return [] {
     std::vector<std::unique_ptr<Stage>> stages;
     stages.push_back(std::make_unique<TagTracker>());
-    if (motion) stages.push_back(std::make_unique<MotionStage>());
-    if (light) stages.push_back(std::make_unique<LightStage>());
+    // The motion stage needs the tracker's poses.
+    stages.push_back(std::make_unique<OptionalStage>(
+        [](const Config& c) { return c.track.enabled && c.motion.enabled; },
+        [] { return std::make_unique<MotionStage>(); }));
+    // The fixed light needs no stage: the renderer takes it from the config.
+    stages.push_back(std::make_unique<OptionalStage>([](const Config& c) { return c.light.source != "fixed"; },
+                                                     [] { return std::make_unique<LightStage>(); }));
     for (auto& stage : make_gl_stages()) stages.push_back(std::move(stage));
     return stages;
   };
@@ -80,9 +94,9 @@ std::unique_ptr<PipelineRunner> assemble_pipeline(const Config& config) {
         source->describe(), double(*interval) * 1e-6));
   // The outputs are opened by start() once the stages are configured: a setup that fails (a bad
   // mesh) or is stopped before then leaves the previous run's outputs as they were.
-  auto runner = std::make_unique<PipelineRunner>(std::move(source), make_stage_factory(config),
+  auto runner = std::make_unique<PipelineRunner>(std::move(source), make_stage_factory(),
                                                  std::vector<std::unique_ptr<FrameSink>>{}, config);
-  runner->make_sinks_at_start([config] { return make_sinks(config); });
+  runner->use_sink_slots(sink_slots());
   return runner;
 }
 

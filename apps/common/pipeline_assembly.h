@@ -6,14 +6,18 @@
 
 #include "core/config/config.h"
 #include "core/pipeline/pipeline_runner.h"
+#include "core/pipeline/sink_slot.h"
 
 namespace arpipe {
 
 std::unique_ptr<FrameSource> make_source(const Config& config);
-std::vector<std::unique_ptr<FrameSink>> make_sinks(const Config& config);
-// track, motion (when tracking and motion are enabled), render, composite (in that order), created
-// on the processing thread. The default config has both on.
-StageFactory make_stage_factory(const Config& config = Config{});
+// The sinks by config key (sinks.results, sinks.png, sinks.y4m, sinks.recording): each made when
+// its section is enabled, and made anew by a reload that changes its section.
+std::vector<SinkSlot> sink_slots();
+// track, motion (while tracking and motion are enabled), light (for any light.source but "fixed"),
+// render, composite (in that order), created on the processing thread; the optional ones come and
+// go with the config, reloads included.
+StageFactory make_stage_factory();
 // All of the above in a runner (not started); the sinks are made by its start(), after the stages.
 std::unique_ptr<PipelineRunner> assemble_pipeline(const Config& config);
 

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <deque>
 #include <exception>
@@ -14,7 +15,10 @@ namespace arpipe {
 
 PipelineRunner::PipelineRunner(std::unique_ptr<FrameSource> source, StageFactory stages,
                                std::vector<std::unique_ptr<FrameSink>> sinks, const Config& config)
-    : source_(std::move(source)), stage_factory_(std::move(stages)), sinks_(std::move(sinks)), config_(config) {}
+    : source_(std::move(source)), stage_factory_(std::move(stages)), config_(config),
+      max_frames_(config.pipeline.max_frames) {
+  for (auto& sink : sinks) sinks_.push_back({std::string(), std::move(sink)});
+}
 
 PipelineRunner::~PipelineRunner() {
   stop();
@@ -26,7 +30,7 @@ void PipelineRunner::start() {
   // Replay must be deterministic frame for frame, so it blocks; a live camera must not fall behind.
   to_process_ = std::make_unique<BoundedQueue<FrameContext>>(
       depth, source_->is_live() ? OverflowPolicy::DropOldest : OverflowPolicy::Block);
-  to_sink_ = std::make_unique<BoundedQueue<FrameContext>>(depth, OverflowPolicy::Block);
+  to_sink_ = std::make_unique<BoundedQueue<ToSink>>(depth, OverflowPolicy::Block);
   start_ns_ = monotonic_now_ns();
 
   // The stages are created and configured on the processing thread, which owns their GL context.
@@ -43,7 +47,7 @@ void PipelineRunner::start() {
         loaders.emplace_back(std::string(stage->name()), std::move(loader));
       }
       for (auto& stage : stages_) stage->prepare(source_->camera_model());
-      reloader_ = std::make_shared<StageReloader>(std::move(loaders));
+      reloader_ = std::make_shared<StageReloader>(std::move(loaders), sink_slots_, config_);
     } catch (...) {
       stages_.clear();
       running_assets_.clear();
@@ -60,9 +64,12 @@ void PipelineRunner::start() {
     throw;
   }
   // The outputs are opened last, once nothing slow or refusable is left before the first frame.
-  if (sink_factory_) {
+  if (sink_factory_ || !sink_slots_.empty()) {
     try {
-      for (auto& sink : sink_factory_()) sinks_.push_back(std::move(sink));
+      if (sink_factory_)
+        for (auto& sink : sink_factory_()) sinks_.push_back({std::string(), std::move(sink)});
+      for (const SinkSlot& slot : sink_slots_)
+        if (std::unique_ptr<FrameSink> sink = slot.make(config_)) sinks_.push_back({slot.key, std::move(sink)});
     } catch (...) {
       to_process_->close();  // the processing thread ends, destroying the stages on its own thread
       processing_thread_.join();
@@ -87,8 +94,8 @@ void PipelineRunner::wait() {
 void PipelineRunner::capture_loop() {
   std::optional<uint64_t> previous_sequence;
   uint64_t index = 0;
-  const int64_t max_frames = config_.pipeline.max_frames;
   while (!stop_requested_) {
+    const int64_t max_frames = max_frames_.load();
     if (max_frames > 0 && int64_t(index) >= max_frames) break;
     FrameContext ctx;
     SourceStatus status = SourceStatus::EndOfStream;
@@ -143,7 +150,7 @@ void PipelineRunner::finish_frame(FrameContext& ctx, size_t first_stage) {
   // Not busy once the stages are done: a push that waits for a slow sink is the sink's stall, and
   // the sink may take the frame before this thread runs again.
   busy_since_ns_ = 0;
-  to_sink_->push(std::move(ctx));
+  to_sink_->push(ToSink{std::move(ctx), nullptr});
 }
 
 void PipelineRunner::processing_loop() {
@@ -182,17 +189,46 @@ void PipelineRunner::processing_loop() {
 void PipelineRunner::sink_loop() {
   // On the sink thread, so it never races consume(): the stages are configured and every sink
   // exists, so the outputs of an earlier run may now be replaced.
-  for (auto& sink : sinks_) sink->run_started();
-  while (auto ctx = to_sink_->pop()) {
+  for (auto& running : sinks_) running.sink->run_started();
+  while (auto item = to_sink_->pop()) {
     sink_busy_since_ns_ = monotonic_now_ns();
-    for (auto& sink : sinks_) sink->consume(*ctx);
+    if (item->swap) {
+      swap_sinks(*item->swap);
+      sink_busy_since_ns_ = 0;
+      continue;
+    }
+    for (auto& running : sinks_) running.sink->consume(item->frame);
     sink_busy_since_ns_ = 0;
     std::lock_guard lock(metrics_mutex_);
     ++metrics_.frames_out;
     metrics_.wall_seconds = double(monotonic_now_ns() - start_ns_) * 1e-9;
   }
-  for (auto& sink : sinks_) sink->flush();
+  for (auto& running : sinks_) running.sink->flush();
   finished_ = true;
+}
+
+void PipelineRunner::swap_sinks(SinkSwap& swap) {
+  for (auto& [key, next] : swap.sinks) {
+    auto running = std::find_if(sinks_.begin(), sinks_.end(), [&](const RunningSink& s) { return s.key == key; });
+    if (running != sinks_.end()) {
+      // Everything it was handed is written and durable, and its output closed, before a new
+      // sink may take over the same path.
+      running->sink->flush();
+      log::info("{}: closed {}", key, running->sink->describe());
+      running->sink.reset();
+    }
+    if (next) {
+      next->run_started();
+      log::info("{}: started {}", key, next->describe());
+    }
+    if (running == sinks_.end()) {
+      if (next) sinks_.push_back({key, std::move(next)});
+    } else if (next) {
+      running->sink = std::move(next);
+    } else {
+      sinks_.erase(running);
+    }
+  }
 }
 
 bool PipelineRunner::reconfigure(const Config& config, std::string& error,
@@ -229,6 +265,9 @@ void PipelineRunner::apply_pending_reconfigure() {
   } else {
     config_ = next.config;
     running_assets_ = next.assets;
+    max_frames_ = config_.pipeline.max_frames;
+    // The frames before this one go to the sinks that were running; from this one on, the new ones.
+    if (next.sinks) to_sink_->push(ToSink{FrameContext(), next.sinks});
   }
   for (auto& stage : stages_) stage->prepare(source_->camera_model());
   reloader_->finish(request, error);

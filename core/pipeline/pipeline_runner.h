@@ -1,4 +1,4 @@
-// Runs source -> stages -> sinks on three threads joined by bounded queues (DESIGN.md "Threads").
+// Runs source -> stages -> sinks on three threads joined by bounded queues (docs/DESIGN.md "Threads").
 // The processing thread owns the stages (and so the GL context the render stages create).
 #pragma once
 
@@ -16,6 +16,7 @@
 #include "core/pipeline/frame_sink.h"
 #include "core/pipeline/frame_source.h"
 #include "core/pipeline/pipeline_metrics.h"
+#include "core/pipeline/sink_slot.h"
 #include "core/pipeline/stage.h"
 #include "core/pipeline/stage_reloader.h"
 
@@ -34,6 +35,10 @@ class PipelineRunner {
   // Sinks that start() makes once every stage is configured, after those given to the constructor:
   // a setup that fails (or is stopped) while loading its assets has not opened a single output.
   void make_sinks_at_start(SinkFactory factory) { sink_factory_ = std::move(factory); }
+  // Sinks by config key, made by start() like those above (after them) from the config it runs,
+  // and made anew by a reload that changes their part of the config (the running one flushed and
+  // closed first, at the frame boundary where the new config takes over).
+  void use_sink_slots(std::vector<SinkSlot> slots) { sink_slots_ = std::move(slots); }
 
   // Starts the threads; blocks until the stages are configured (their assets loaded on the
   // processing thread, which has nothing else to do yet) and the sinks made. Throws if that failed.
@@ -44,9 +49,10 @@ class PipelineRunner {
   void wait();
   bool finished() const { return finished_; }
 
-  // A reload: the stages' assets are loaded on the calling thread, then swapped in by the processing
-  // thread at a frame boundary (StageReloader::reconfigure); false (with the reason) keeps the
-  // running config, and a refused reload is never applied later. Only after start().
+  // A reload: the stages' assets are loaded (and changed sinks made) on the calling thread, then
+  // swapped in by the processing thread at a frame boundary (StageReloader::reconfigure); false
+  // (with the reason) keeps the running config, and a refused reload is never applied later. Only
+  // after start(). pipeline.queue_depth and the source are taken once, by start().
   bool reconfigure(const Config& config, std::string& error,
                    std::chrono::milliseconds boundary_timeout = kReconfigureBoundaryTimeout);
   // For a reload from another thread that must not keep the runner alive (it may be stuck loading).
@@ -70,16 +76,30 @@ class PipelineRunner {
   // Runs the stages from first_stage on, counts the frame in the metrics and hands it to the sinks.
   void finish_frame(FrameContext& ctx, size_t first_stage);
   void sink_loop();
+  // On the sink thread, between two frames: closes and starts the sinks a reload changed.
+  void swap_sinks(SinkSwap& swap);
+
+  // What the sink thread takes, in order: a frame, or the sinks a reload changed.
+  struct ToSink {
+    FrameContext frame;
+    std::shared_ptr<SinkSwap> swap;  // when set, no frame
+  };
+  struct RunningSink {
+    std::string key;  // its SinkSlot's; empty for the sinks no reload replaces
+    std::unique_ptr<FrameSink> sink;
+  };
 
   std::unique_ptr<FrameSource> source_;
   StageFactory stage_factory_;
   SinkFactory sink_factory_;
+  std::vector<SinkSlot> sink_slots_;
   std::vector<std::unique_ptr<Stage>> stages_;
   std::vector<std::shared_ptr<const StageAssets>> running_assets_;  // what config_ was loaded into, per stage
-  std::vector<std::unique_ptr<FrameSink>> sinks_;
+  std::vector<RunningSink> sinks_;  // the sink thread's once it runs
   Config config_;
+  std::atomic<int64_t> max_frames_{0};  // config_.pipeline.max_frames, for the capture thread
   std::unique_ptr<BoundedQueue<FrameContext>> to_process_;
-  std::unique_ptr<BoundedQueue<FrameContext>> to_sink_;
+  std::unique_ptr<BoundedQueue<ToSink>> to_sink_;
   std::thread capture_thread_, processing_thread_, sink_thread_;
   std::atomic<bool> stop_requested_{false};
   std::atomic<bool> finished_{false};

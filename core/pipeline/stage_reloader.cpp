@@ -1,4 +1,4 @@
-// Reloads the stages' config while frames flow (see stage_reloader.h).
+// Reloads the stages' config and the sinks while frames flow (see stage_reloader.h).
 #include "core/pipeline/stage_reloader.h"
 
 #include <fmt/format.h>
@@ -14,8 +14,9 @@ struct StageReloader::Request {
   std::string error;  // the answer; empty: accepted
 };
 
-StageReloader::StageReloader(std::vector<std::pair<std::string, StageAssetLoader>> loaders)
-    : loaders_(std::move(loaders)) {}
+StageReloader::StageReloader(std::vector<std::pair<std::string, StageAssetLoader>> loaders,
+                             std::vector<SinkSlot> sinks, Config running)
+    : loaders_(std::move(loaders)), sink_slots_(std::move(sinks)), running_(std::move(running)) {}
 
 uint64_t StageReloader::new_ticket() {
   std::lock_guard lock(mutex_);
@@ -37,8 +38,28 @@ std::string StageReloader::refusal_locked(uint64_t ticket) const {
   return {};
 }
 
+bool StageReloader::make_sinks(uint64_t ticket, const Config& running, const Config& config, Loaded& loaded,
+                               std::string& error) {
+  for (const SinkSlot& slot : sink_slots_) {
+    if (slot.same(running, config)) continue;
+    {
+      std::lock_guard lock(mutex_);
+      error = refusal_locked(ticket);
+      if (!error.empty()) return false;
+    }
+    if (!loaded.sinks) loaded.sinks = std::make_shared<SinkSwap>();
+    try {
+      loaded.sinks->sinks.emplace_back(slot.key, slot.make(config));
+    } catch (const std::exception& e) {
+      error = fmt::format("{}: {}", slot.key, e.what());
+      return false;  // the sinks made so far close unused: their outputs stay as they were
+    }
+  }
+  return true;
+}
+
 bool StageReloader::reconfigure(uint64_t ticket, const Config& config, std::string& error,
-                                std::chrono::milliseconds boundary_timeout) {
+                                std::chrono::milliseconds boundary_timeout, Config* replaced) {
   auto request = std::make_shared<Request>();
   request->loaded.config = config;
   for (const auto& [stage, loader] : loaders_) {
@@ -54,6 +75,19 @@ bool StageReloader::reconfigure(uint64_t ticket, const Config& config, std::stri
       return false;
     }
   }
+
+  // The sinks are compared with the config this reload will replace. Once this ticket is the
+  // newest, only a reload the processing thread has already claimed can still change that config:
+  // its answer is waited for (swapping in is GPU uploads only, so it comes soon).
+  Config running;
+  {
+    std::unique_lock lock(mutex_);
+    answered_.wait(lock, [&] { return !claimed_; });
+    error = refusal_locked(ticket);
+    if (!error.empty()) return false;
+    running = running_;
+  }
+  if (!make_sinks(ticket, running, config, request->loaded, error)) return false;
 
   std::unique_lock lock(mutex_);
   error = refusal_locked(ticket);
@@ -72,6 +106,7 @@ bool StageReloader::reconfigure(uint64_t ticket, const Config& config, std::stri
   // Claimed: swapping in is GPU uploads only, so the answer comes soon.
   answered_.wait(lock, [&] { return request->state == Request::State::Answered; });
   error = request->error;
+  if (error.empty() && replaced) *replaced = std::move(running);
   return error.empty();
 }
 
@@ -79,7 +114,10 @@ std::shared_ptr<StageReloader::Request> StageReloader::claim() {
   std::lock_guard lock(mutex_);
   std::shared_ptr<Request> request;
   request.swap(pending_);
-  if (request) request->state = Request::State::Claimed;
+  if (request) {
+    request->state = Request::State::Claimed;
+    claimed_ = true;
+  }
   return request;
 }
 
@@ -89,6 +127,8 @@ void StageReloader::finish(const std::shared_ptr<Request>& request, const std::s
   std::lock_guard lock(mutex_);
   request->error = error;
   request->state = Request::State::Answered;
+  if (error.empty()) running_ = request->loaded.config;
+  claimed_ = false;
   answered_.notify_all();
 }
 

@@ -168,7 +168,7 @@ TEST_F(DaemonInput, SighupReloadRefusesBadConfigAndKeepsRunning) {
   EXPECT_NE(child.stderr_text().find("no_such_key"), std::string::npos) << child.stderr_text();
   std::ofstream(config, std::ios::trunc) << good << "[render]\nlight_direction = [0.0, 0.0, 1.0]\n";
   child.signal(SIGHUP);
-  EXPECT_TRUE(child.wait_for_stderr("reload accepted")) << child.stderr_text();
+  EXPECT_TRUE(child.wait_for_stderr("reload applied: render")) << child.stderr_text();
   child.signal(SIGTERM);
   const int status = child.wait(std::chrono::seconds(30));
   ASSERT_TRUE(status != -1 && WIFEXITED(status)) << child.stderr_text();

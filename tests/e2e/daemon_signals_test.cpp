@@ -210,13 +210,13 @@ TEST_F(DaemonSignals, SlowReloadLoadsBesideTheRunningPipelineAndIsSuperseded) {
   // running config.
   const size_t lines = result_lines();
   EXPECT_TRUE(frames_flow_past(lines + 5, std::chrono::seconds(10))) << child->stderr_text();
-  EXPECT_EQ(child->stderr_text().find("reload accepted"), std::string::npos) << "the bake was expected to take longer";
+  EXPECT_EQ(child->stderr_text().find("reload applied"), std::string::npos) << "the bake was expected to take longer";
 
-  // A newer SIGHUP (the old config again) is accepted, and the slow one is never applied.
+  // A newer SIGHUP (the old config again) is applied, and the slow one is never applied.
   std::ofstream(config, std::ios::trunc) << good;
   child->signal(SIGHUP);
   EXPECT_TRUE(child->wait_for_stderr("supersedes the reload still loading")) << child->stderr_text();
-  EXPECT_TRUE(child->wait_for_stderr("reload accepted")) << child->stderr_text();
+  EXPECT_TRUE(child->wait_for_stderr("reload applied: no key changed")) << child->stderr_text();
 
   // The superseded bake is still running: SIGTERM does not wait for it.
   const Ending ending = signal_and_time(*child, SIGTERM);
@@ -225,9 +225,9 @@ TEST_F(DaemonSignals, SlowReloadLoadsBesideTheRunningPipelineAndIsSuperseded) {
   ASSERT_TRUE(WIFEXITED(ending.status)) << "died of signal " << WTERMSIG(ending.status) << ": " << err;
   EXPECT_EQ(WEXITSTATUS(ending.status), 0) << err;
   EXPECT_LE(ending.seconds, kDrainSeconds) << err;
-  // Exactly one reload was accepted: the newer one.
+  // Exactly one reload was applied: the newer one.
   size_t accepted = 0;
-  for (size_t at = err.find("reload accepted"); at != std::string::npos; at = err.find("reload accepted", at + 1))
+  for (size_t at = err.find("reload applied"); at != std::string::npos; at = err.find("reload applied", at + 1))
     ++accepted;
   EXPECT_EQ(accepted, 1u) << err;
 }
@@ -253,7 +253,7 @@ TEST_F(DaemonSignals, ReloadStuckOnAFifoMeshNeitherStallsFramesNorStop) {
   ASSERT_TRUE(WIFEXITED(ending.status)) << "died of signal " << WTERMSIG(ending.status) << ": " << err;
   EXPECT_EQ(WEXITSTATUS(ending.status), 0) << err;
   EXPECT_LE(ending.seconds, kDrainSeconds) << err;
-  EXPECT_EQ(err.find("reload accepted"), std::string::npos) << err;
+  EXPECT_EQ(err.find("reload applied"), std::string::npos) << err;
 }
 
 // Finding 9: a missing mesh names the config key as well as the file.

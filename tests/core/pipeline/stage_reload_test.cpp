@@ -1,12 +1,16 @@
 // Reloads through the PipelineRunner with stages whose assets load slowly (StageReloader): the
 // loading runs on the reloading thread while frames flow, a refused or superseded reload is never
-// applied later, a refusal puts the stages back without loading again; sinks are made last.
+// applied later, a refusal puts the stages back without loading again; sinks are made last. A
+// reload replaces the sinks whose part of the config changed at a frame boundary and adds or
+// removes the stages that run only while the config asks for them.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <condition_variable>
 #include <functional>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <stdexcept>
@@ -14,6 +18,7 @@
 #include <thread>
 #include <vector>
 
+#include "core/pipeline/optional_stage.h"
 #include "core/pipeline/pipeline_runner.h"
 
 namespace arpipe {
@@ -57,6 +62,10 @@ struct Log {
   size_t frames_consumed = 0;
   int sinks_made = 0;
   std::vector<std::string> sink_events;                              // "started", "frame", "flush"
+  std::map<std::string, size_t> processed_by;                         // frames per stage name
+  std::map<std::string, int> stages_made;                             // per stage name
+  std::vector<std::string> slot_events;                               // "<tag> started|flush|closed"
+  std::map<std::string, size_t> consumed_by;                          // frames per slot sink tag
 
   template <typename Predicate>
   bool wait_for(Predicate done, std::chrono::seconds timeout = 30s) {
@@ -157,7 +166,10 @@ class LoadingStage : public Stage {
   }
 
   void process(FrameContext&) noexcept override {
-    log_->record([&] { ++log_->frames_processed; });
+    log_->record([&] {
+      ++log_->frames_processed;
+      ++log_->processed_by[script_.name];
+    });
   }
 
  private:
@@ -186,19 +198,76 @@ class RecordingSink : public FrameSink {
   std::shared_ptr<Log> log_;
 };
 
+// A sink of a SinkSlot, named by its tag (the part of the config it was made from).
+class TaggedSink : public FrameSink {
+ public:
+  TaggedSink(std::string tag, std::shared_ptr<Log> log) : tag_(std::move(tag)), log_(std::move(log)) {}
+  ~TaggedSink() override { event("closed"); }
+  std::string describe() const override { return "sink " + tag_; }
+  void run_started() noexcept override { event("started"); }
+  void consume(const FrameContext&) noexcept override {
+    log_->record([&] { ++log_->consumed_by[tag_]; });
+  }
+  void flush() noexcept override { event("flush"); }
+
+ private:
+  void event(const std::string& what) {
+    log_->record([&] { log_->slot_events.push_back(tag_ + " " + what); });
+  }
+  std::string tag_;
+  std::shared_ptr<Log> log_;
+};
+
+// Two slots: "sinks.results" made from sinks.results.path (tag "results:<path>"), "sinks.png" from
+// sinks.png.dir (tag "png:<dir>"); a disabled section makes none. A dir named "unwritable"
+// cannot be opened.
+std::vector<SinkSlot> tagged_slots(std::shared_ptr<Log> log) {
+  std::vector<SinkSlot> slots;
+  slots.push_back({"sinks.results", [](const Config& a, const Config& b) { return a.sinks.results == b.sinks.results; },
+                   [log](const Config& c) -> std::unique_ptr<FrameSink> {
+                     if (!c.sinks.results.enabled) return nullptr;
+                     return std::make_unique<TaggedSink>("results:" + c.sinks.results.path.string(), log);
+                   }});
+  slots.push_back({"sinks.png", [](const Config& a, const Config& b) { return a.sinks.png == b.sinks.png; },
+                   [log](const Config& c) -> std::unique_ptr<FrameSink> {
+                     if (!c.sinks.png.enabled) return nullptr;
+                     if (c.sinks.png.dir == "unwritable") throw std::runtime_error("cannot create unwritable");
+                     return std::make_unique<TaggedSink>("png:" + c.sinks.png.dir.string(), log);
+                   }});
+  return slots;
+}
+
+Config with_sinks(Config config, const std::string& png_dir, const std::string& results_path = "r") {
+  config.sinks.png.enabled = !png_dir.empty();
+  config.sinks.png.dir = png_dir;
+  config.sinks.results.path = results_path;
+  return config;
+}
+
 struct Pipeline {
   std::shared_ptr<Log> log = std::make_shared<Log>();
   std::shared_ptr<Tap> tap = std::make_shared<Tap>();
   std::unique_ptr<PipelineRunner> runner;
 
-  explicit Pipeline(std::vector<StageScript> scripts) {
-    StageFactory factory = [scripts, log = log] {
+  // `wrap`: which stages run only while the config asks for them (OptionalStage), by name.
+  explicit Pipeline(std::vector<StageScript> scripts, Config first = marked("run"),
+                    std::map<std::string, OptionalStage::Wanted> optional = {}) {
+    StageFactory factory = [scripts, optional, log = log] {
       std::vector<std::unique_ptr<Stage>> stages;
-      for (const auto& script : scripts) stages.push_back(std::make_unique<LoadingStage>(script, log));
+      for (const auto& script : scripts) {
+        auto make = [script, log] {
+          log->record([&] { ++log->stages_made[script.name]; });
+          return std::make_unique<LoadingStage>(script, log);
+        };
+        if (auto wanted = optional.find(script.name); wanted != optional.end())
+          stages.push_back(std::make_unique<OptionalStage>(wanted->second, make));
+        else
+          stages.push_back(make());
+      }
       return stages;
     };
     runner = std::make_unique<PipelineRunner>(std::make_unique<TapSource>(tap), factory,
-                                              std::vector<std::unique_ptr<FrameSink>>{}, marked("run"));
+                                              std::vector<std::unique_ptr<FrameSink>>{}, first);
     runner->make_sinks_at_start([log = log] {
       log->record([&] { ++log->sinks_made; });
       std::vector<std::unique_ptr<FrameSink>> sinks;
@@ -414,6 +483,125 @@ TEST(StageReload, ReloadAfterTheStreamEndedIsRefused) {
   EXPECT_FALSE(p.runner->reconfigure(marked("after"), error));
   EXPECT_NE(error.find("stream has ended"), std::string::npos) << error;
   EXPECT_FALSE(p.ever_configured_with("after"));
+}
+
+size_t consumed_by(Pipeline& p, const std::string& tag) {
+  std::lock_guard lock(p.log->mutex);
+  return p.log->consumed_by[tag];
+}
+std::vector<std::string> slot_events(Pipeline& p) {
+  std::lock_guard lock(p.log->mutex);
+  return p.log->slot_events;
+}
+
+// A re-pointed sink: the old one gets every frame before the boundary and is flushed and closed
+// before the new one starts, which gets every frame after it; the sink whose part did not change
+// runs on untouched and gets every frame.
+TEST(StageReload, ChangedSinkIsReplacedAtAFrameBoundaryAndTheOthersRunOnUntouched) {
+  Pipeline p({StageScript{}}, with_sinks(marked("run"), "a"));
+  p.runner->use_sink_slots(tagged_slots(p.log));
+  p.runner->start();
+  ASSERT_TRUE(p.log->wait_for([&] { return p.log->consumed_by["png:a"] >= 5; }));
+  std::string error;
+  Config replaced;
+  ASSERT_TRUE(p.runner->reloader()->reconfigure(p.runner->reloader()->new_ticket(), with_sinks(marked("next"), "b"),
+                                                error, 10s, &replaced))
+      << error;
+  EXPECT_EQ(replaced, with_sinks(marked("run"), "a"));
+  ASSERT_TRUE(p.log->wait_for([&] { return p.log->consumed_by["png:b"] >= 5; }));
+  const std::vector<std::string> expected{"results:r started", "png:a started", "png:a flush", "png:a closed",
+                                          "png:b started"};
+  EXPECT_EQ(slot_events(p), expected);
+  p.runner->stop();
+  p.runner->wait();
+  EXPECT_EQ(consumed_by(p, "png:a") + consumed_by(p, "png:b"), consumed_by(p, "results:r"));
+}
+
+TEST(StageReload, SinkTheReloadedConfigNoLongerAsksForIsFlushedAndClosed) {
+  Pipeline p({StageScript{}}, with_sinks(marked("run"), "a"));
+  p.runner->use_sink_slots(tagged_slots(p.log));
+  p.runner->start();
+  ASSERT_TRUE(p.log->wait_for([&] { return p.log->consumed_by["png:a"] >= 3; }));
+  std::string error;
+  ASSERT_TRUE(p.runner->reconfigure(with_sinks(marked("next"), ""), error)) << error;
+  ASSERT_TRUE(p.log->wait_for([&] {
+    return std::find(p.log->slot_events.begin(), p.log->slot_events.end(), "png:a closed") != p.log->slot_events.end();
+  }));
+  const size_t a = consumed_by(p, "png:a"), results = consumed_by(p, "results:r");
+  ASSERT_TRUE(p.log->wait_for([&] { return p.log->consumed_by["results:r"] >= results + 5; }));
+  EXPECT_EQ(consumed_by(p, "png:a"), a);
+  // Added back by a later reload: a new sink, from then on.
+  ASSERT_TRUE(p.runner->reconfigure(with_sinks(marked("again"), "a"), error)) << error;
+  ASSERT_TRUE(p.log->wait_for([&] { return p.log->consumed_by["png:a"] >= a + 3; }));
+  const std::vector<std::string> events = slot_events(p);
+  EXPECT_EQ(std::count(events.begin(), events.end(), "png:a started"), 2);
+}
+
+// A sink that cannot be made refuses the whole reload: the stages never see the config and the
+// running sinks stay.
+TEST(StageReload, SinkThatCannotBeMadeRefusesTheReload) {
+  Pipeline p({StageScript{}}, with_sinks(marked("run"), "a"));
+  p.runner->use_sink_slots(tagged_slots(p.log));
+  p.runner->start();
+  ASSERT_TRUE(p.log->wait_for([&] { return p.log->consumed_by["png:a"] >= 1; }));  // the sinks have started
+  std::string error;
+  EXPECT_FALSE(p.runner->reconfigure(with_sinks(marked("bad"), "unwritable", "r2"), error));
+  EXPECT_EQ(error, "sinks.png: cannot create unwritable");
+  const size_t a = consumed_by(p, "png:a");
+  ASSERT_TRUE(p.log->wait_for([&] { return p.log->consumed_by["png:a"] >= a + 5; }));
+  EXPECT_FALSE(p.ever_configured_with("bad"));
+  const std::vector<std::string> events = slot_events(p);
+  // The results sink made for it was closed without ever starting (its output stays as it was).
+  EXPECT_EQ(events, (std::vector<std::string>{"results:r started", "png:a started", "results:r2 closed"}));
+}
+
+// The stage "optional" runs while the config's marker starts with "on": a reload adds it (a fresh
+// one, since frames went by without it), removes it, and a reload refused by a later stage puts it
+// back as it was. Its loader runs only for the configs that want it.
+TEST(StageReload, OptionalStageComesAndGoesWithTheConfig) {
+  StageScript always;
+  always.name = "always";
+  StageScript optional;
+  optional.name = "optional";
+  StageScript picky;
+  picky.name = "picky";
+  picky.loads = false;
+  picky.refuses = "off-refused";
+  const auto on = [](const Config& c) { return c.pipeline.log_level.rfind("on", 0) == 0; };
+  Pipeline p({always, optional, picky}, marked("off"), {{"optional", on}});
+  p.runner->start();
+  const auto processed_by = [&](const std::string& stage) {
+    std::lock_guard lock(p.log->mutex);
+    return p.log->processed_by[stage];
+  };
+  const auto loaded = [&] {
+    std::lock_guard lock(p.log->mutex);
+    return p.log->loaded;
+  };
+  ASSERT_TRUE(p.frames_flow_past(10));
+  EXPECT_EQ(processed_by("optional"), 0u);
+  EXPECT_EQ(loaded(), (std::vector<std::string>{"off"}));  // "always" only
+
+  std::string error;
+  ASSERT_TRUE(p.runner->reconfigure(marked("on"), error)) << error;
+  EXPECT_EQ(loaded(), (std::vector<std::string>{"off", "on", "on"}));
+  ASSERT_TRUE(p.log->wait_for([&] { return p.log->processed_by["optional"] >= 5; }));
+
+  EXPECT_FALSE(p.runner->reconfigure(marked("off-refused"), error));
+  EXPECT_EQ(error, "stage picky: picky refuses 'off-refused'");
+  const size_t before_refused = processed_by("optional");
+  ASSERT_TRUE(p.log->wait_for([&] { return p.log->processed_by["optional"] >= before_refused + 5; }));
+
+  ASSERT_TRUE(p.runner->reconfigure(marked("off"), error)) << error;
+  const size_t always_frames = processed_by("always"), optional_frames = processed_by("optional");
+  ASSERT_TRUE(p.log->wait_for([&] { return p.log->processed_by["always"] >= always_frames + 10; }));
+  EXPECT_EQ(processed_by("optional"), optional_frames);
+
+  std::lock_guard lock(p.log->mutex);
+  // Made by the factory, then once more when switched on after frames went by without it; the
+  // refused reload put the running one back.
+  EXPECT_EQ(p.log->stages_made["optional"], 2);
+  EXPECT_EQ(p.log->stages_made["always"], 1);
 }
 
 }  // namespace
