@@ -15,6 +15,7 @@
 #include "render/gl/fullscreen_triangle.h"
 #include "render/gl/gl_error.h"
 #include "render/gl/render_errors.h"
+#include "render/pixel_rect.h"
 
 namespace arpipe {
 namespace {
@@ -169,8 +170,9 @@ void CompositeStage::ensure_targets(int width, int height) {
 
 void CompositeStage::composite(FrameContext& ctx) {
   const int width = ctx.camera.width, height = ctx.camera.height;
-  const RenderSession::DrawnLayer& layer = session_->drawn;
-  const PixelRect rect = layer.rect;
+  const VirtualLayerTexture& layer = ctx.virtual_layer;
+  const PixelRect rect{layer.x, layer.y, layer.rect_width, layer.rect_height};
+  if (layer.texture == 0) throw RenderError("the frame's virtual layer names no texture");
   if (layer.width != width || layer.height != height)
     throw RenderError(fmt::format("the virtual layer is {}x{} but the camera frame is {}x{}", layer.width,
                                   layer.height, width, height));

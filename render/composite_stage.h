@@ -32,7 +32,8 @@ class CompositeStage final : public Stage {
   // encode_srgb(V.rgb + (1 - V.a) * decode_srgb(camera)) inside the drawn rectangle. The camera
   // picture is the camera's sRGB bytes as they were, or, with render.lens = "undistort", the frame
   // undistorted to its pinhole core (on the CPU, every frame); ctx.output_camera_model says which.
-  // Without a virtual layer this frame, no GL at all. On an error: the camera frame as it was.
+  // The layer is the texture the render stage named in ctx.virtual_layer. Without a virtual layer
+  // this frame, no GL at all. On an error: the camera frame as it was.
   void process(FrameContext& ctx) noexcept override;
 
  private:

@@ -1,5 +1,5 @@
 // What the render and composite stages share: the one EGL context (made by the first configure,
-// on the processing thread), the layer that objects are drawn into, and what was drawn this frame.
+// on the processing thread) and the layer that objects are drawn into.
 #include "render/render_session.h"
 
 #include "core/log.h"

@@ -1,5 +1,6 @@
 // What the render and composite stages share: the one EGL context (made by the first configure,
-// on the processing thread), the layer that objects are drawn into, and what was drawn this frame.
+// on the processing thread) and the layer that objects are drawn into. What was drawn on a frame
+// travels in its FrameContext (FrameContext::virtual_layer).
 #pragma once
 
 #include <GLES3/gl3.h>
@@ -8,7 +9,6 @@
 #include <string>
 
 #include "render/gl/egl_context.h"
-#include "render/pixel_rect.h"
 #include "render/virtual_layer.h"
 
 namespace arpipe {
@@ -33,17 +33,6 @@ class RenderSession {
   // Where the objects are drawn: at the camera image's size, or the pinhole canvas's with
   // render.lens = "map".
   VirtualLayer& layer() { return *layer_; }
-
-  // The virtual layer as the composite stage reads it this frame: a texture at the output image's
-  // size, linear with premultiplied alpha, image row v on GL row v, valid inside rect. It is the
-  // layer's own texture, or the lens warp's output. Meaningful when ctx.virtual_layer_drawn.
-  struct DrawnLayer {
-    GLuint texture = 0;
-    int width = 0;
-    int height = 0;
-    PixelRect rect;
-  };
-  DrawnLayer drawn;
 
  private:
   std::unique_ptr<EglContext> context_;

@@ -127,9 +127,13 @@ std::shared_ptr<const CameraModel> RenderStage::pinhole_core(const std::shared_p
   });
 }
 
+// FrameContext::virtual_layer carries the texture's name without the GL headers.
+static_assert(sizeof(GLuint) == sizeof(VirtualLayerTexture::texture));
+
 void RenderStage::process(FrameContext& ctx) noexcept {
   const auto start = std::chrono::steady_clock::now();
   ctx.virtual_layer_drawn = false;
+  ctx.virtual_layer = {};
   try {
     std::string skip;
     if (!settings_.enabled) skip = "render disabled";
@@ -244,7 +248,7 @@ void RenderStage::draw(FrameContext& ctx) {
   // The work is queued until something waits for it; waiting here keeps the stage timings honest.
   glFinish();
   check_gl("drawing the virtual layer");
-  session_->drawn = {drawn_texture, camera.width(), camera.height(), rect};
+  ctx.virtual_layer = {drawn_texture, camera.width(), camera.height(), rect.x, rect.y, rect.width, rect.height};
   ctx.virtual_layer_drawn = true;
   ctx.blur_method = std::string(blur_method_name(drawn.method));
   ctx.blur_samples = drawn.samples;

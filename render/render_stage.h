@@ -38,6 +38,7 @@ class RenderStage final : public Stage {
   // 640x480) before streaming starts; "undistort": its pinhole core. A frame with another model
   // builds its own on its first drawn frame.
   void prepare(const std::shared_ptr<const CameraModel>& camera_model) noexcept override;
+  // Drawn: ctx.virtual_layer_drawn, and ctx.virtual_layer names the texture for the composite stage.
   // Skips (ctx.virtual_layer_drawn = false, reason recorded) when rendering is off, there are no
   // objects, there is no pose (neither Tracking nor Predicted within
   // render.max_predicted_uncertainty_deg), or no object's box reaches into the

@@ -52,6 +52,21 @@ struct StageTiming {
   std::string skipped;  // empty when the stage ran; otherwise why it returned at once
 };
 
+// The virtual layer as the render stage hands it to the composite stage: a GL texture at the output
+// image's size, linear with premultiplied alpha, image row v on GL row v, that holds the layer inside
+// the rectangle (x, y, rect_width, rect_height). The texture belongs to the render stages' GL
+// session, which keeps it alive; its name is good on the processing thread only, until the render
+// stage draws the next frame (the runner runs the composite stage right after it), never in a sink.
+struct VirtualLayerTexture {
+  uint32_t texture = 0;  // a GLuint; 0: none
+  int width = 0;
+  int height = 0;
+  int x = 0;
+  int y = 0;
+  int rect_width = 0;
+  int rect_height = 0;
+};
+
 struct FrameContext {
   Frame camera;                                 // the input frame, in the source's pixel format
   std::shared_ptr<const CameraModel> camera_model;
@@ -66,6 +81,8 @@ struct FrameContext {
   // is "undistort" (the output is then an undistorted picture). Set with ctx.output.
   std::shared_ptr<const CameraModel> output_camera_model;
   bool virtual_layer_drawn = false;
+  // The virtual layer the render stage drew, for the composite stage (set with virtual_layer_drawn).
+  VirtualLayerTexture virtual_layer;
   // How the virtual layer was drawn: "off" (sharp) or the render.blur method used, and its samples.
   std::string blur_method = "off";
   int blur_samples = 0;
