@@ -191,7 +191,7 @@ SourceStatus ReplaySource::Impl::next(Frame& frame) {
 SourceStatus ReplaySource::next(Frame& frame) {
   try {
     return impl_->next(frame);
-  } catch (const std::exception& e) {  // per-frame code never throws (DESIGN.md "Errors")
+  } catch (const std::exception& e) {  // per-frame code never throws (docs/DESIGN.md "Errors")
     log::error("replay {}: {}", impl_->config.path.string(), e.what());
     return SourceStatus::Retry;
   }

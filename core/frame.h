@@ -1,4 +1,4 @@
-// A camera frame: pixels in the source's own format plus the exposure metadata of DESIGN.md.
+// A camera frame: pixels in the source's own format plus the exposure metadata of docs/DESIGN.md.
 // Timestamps are int64 nanoseconds on CLOCK_MONOTONIC.
 #pragma once
 
@@ -40,7 +40,7 @@ struct FrameMetadata {
   double total_gain() const { return analogue_gain * digital_gain; }
 };
 
-// Turns a raw source timestamp into exposure_start_ns per DESIGN.md:
+// Turns a raw source timestamp into exposure_start_ns per docs/DESIGN.md:
 // end of frame minus exposure and readout; plus the configured per-camera offset.
 int64_t exposure_start_from_raw(int64_t raw_ns, TimestampMeaning meaning, int64_t exposure_ns,
                                 int64_t readout_ns, int64_t offset_ns);

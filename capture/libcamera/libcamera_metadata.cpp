@@ -68,7 +68,7 @@ LibcameraMapped map_libcamera_metadata(const LibcameraRequestValues& values, uin
   m.colour_temperature_k = values.colour_temperature_k.value_or(0.0);
 
   // libcamera documents SensorTimestamp as "the time when the first row of the image sensor active
-  // array is exposed" (control_ids.yaml), i.e. DESIGN.md's exposure start. Its clock is documented
+  // array is exposed" (control_ids.yaml), i.e. docs/DESIGN.md's exposure start. Its clock is documented
   // as CLOCK_BOOTTIME, but pipeline handlers copy the V4L2 buffer timestamp, which is
   // CLOCK_MONOTONIC (libcamera bug 254); the two agree unless the board has been suspended.
   // Raspberry Pi's pipeline stamps the frame-start interrupt instead (first row read out, i.e.

@@ -1,4 +1,4 @@
-// libcamera's per-request metadata as plain optional values, and its mapping to DESIGN.md's
+// libcamera's per-request metadata as plain optional values, and its mapping to docs/DESIGN.md's
 // FrameMetadata. No libcamera types here, so the mapping is tested without a camera.
 #pragma once
 

@@ -66,7 +66,7 @@ class CameraStream {
   virtual std::string describe() const = 0;
   virtual const StreamFormat& format() const = 0;
   // Waits up to timeout_ns for the next frame and fills `frame` (pixels in format().format,
-  // metadata normalised per DESIGN.md; sequence as the camera numbers it). Never throws; a
+  // metadata normalised per docs/DESIGN.md; sequence as the camera numbers it). Never throws; a
   // status other than Frame comes with a reason in `why`.
   virtual StreamStatus next(Frame& frame, int64_t timeout_ns, std::string& why) = 0;
   // Makes a blocked next() return Interrupted soon (from another thread).

@@ -156,7 +156,7 @@ struct SimCamera {
   double digital_gain = 1.0;
   int64_t readout_ns = 0;  // first row to last row; 0: global shutter
   // The timestamp the simulated driver reports, and the per-camera offset that turns it back
-  // into the exposure start (DESIGN.md "Time"): raw = exposure_start - offset (+ exposure +
+  // into the exposure start (docs/DESIGN.md "Time"): raw = exposure_start - offset (+ exposure +
   // readout for EndOfFrame).
   TimestampMeaning timestamp_meaning = TimestampMeaning::StartOfExposure;
   int64_t timestamp_offset_ns = 0;

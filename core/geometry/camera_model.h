@@ -1,5 +1,5 @@
 // The one camera model of the project: an mrcal lens model plus intrinsics and imager size.
-// Every projection of a 3D point into a camera image goes through here (DESIGN.md "Space").
+// Every projection of a 3D point into a camera image goes through here (docs/DESIGN.md "Space").
 #pragma once
 
 #include <filesystem>

@@ -1,5 +1,5 @@
 // Rigid transforms in double precision: SE(3) with compose, inverse, exp/log and interpolation.
-// Named T_to_from: T_cam_world * p_world = p_cam (DESIGN.md "Space").
+// Named T_to_from: T_cam_world * p_world = p_cam (docs/DESIGN.md "Space").
 #pragma once
 
 #include <array>

@@ -1,4 +1,4 @@
-// The camera's response curve (encoded 8-bit value -> linear light in [0, 1]), as DESIGN.md's colour
+// The camera's response curve (encoded 8-bit value -> linear light in [0, 1]), as docs/DESIGN.md's colour
 // rule needs: "srgb" (default), "linear" or "gamma:<g>", decoded through a 256-entry table.
 #pragma once
 

@@ -1,4 +1,4 @@
-// CLOCK_MONOTONIC in int64 nanoseconds, the one time base of the project (DESIGN.md "Time"),
+// CLOCK_MONOTONIC in int64 nanoseconds, the one time base of the project (docs/DESIGN.md "Time"),
 // and the millisecond stopwatch the stages time themselves with.
 #pragma once
 

@@ -9,7 +9,7 @@
 
 namespace arpipe {
 
-// T_world_tag of a bundle tag, in the tag frame of DESIGN.md (x right, y towards the printed top,
+// T_world_tag of a bundle tag, in the tag frame of docs/DESIGN.md (x right, y towards the printed top,
 // z out of the face): a rotation by yaw about world z, then a shift to the tag's centre.
 SE3 bundle_tag_pose(const BundleTag& tag);
 

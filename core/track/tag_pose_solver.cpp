@@ -36,7 +36,7 @@ void se3_to_cv(const SE3& pose, cv::Mat& rvec, cv::Mat& tvec) {
   tvec = (cv::Mat_<double>(3, 1) << t[0], t[1], t[2]);
 }
 
-// T_world_tag of a square from its world corners (BL, BR, TR, TL), in the tag frame of DESIGN.md,
+// T_world_tag of a square from its world corners (BL, BR, TR, TL), in the tag frame of docs/DESIGN.md,
 // and its edge length.
 SE3 square_pose_in_world(const std::array<Vec3, 4>& w, double& edge) {
   const Vec3 center = 0.25 * (w[0] + w[1] + w[2] + w[3]);

@@ -60,8 +60,8 @@ const fs::path kSunCapture = fs::path(ARPIPE_BINARY_DIR) / "sun-outdoor-capture"
 const fs::path kProbeCapture = fs::path(ARPIPE_BINARY_DIR) / "probe-indoor-capture";
 
 // The scene's sun: azimuth 135, elevation 40 (world north = +y). configs/sun-outdoor.toml's place
-// and time give SPA's 135.000005 / 40.000008 degrees at the first frame (tests/light/
-// test_sun_spa.cpp); later frames add their own time, and the real sun moves 0.004 degrees a
+// and time give SPA's 135.000005 / 40.000008 degrees at the first frame (tests/sun/
+// sun_spa_test.cpp); later frames add their own time, and the real sun moves 0.004 degrees a
 // second where the simulator's stands still: 0.0015 degrees by the last frame, 0.37 s on.
 TEST(LightReplay, SunFromPlaceAndTimeWithShadows) {
   const DaemonRun run = run_arpiped("sun", kConfigs / "sun-outdoor.toml", kSunCapture);
@@ -128,7 +128,7 @@ TEST(LightReplay, MirrorProbeFindsTheLampThroughTheWholeDaemon) {
 
 // An HDR light probe file as the whole light, through the daemon: a constant 0.5 (exact in RGBE)
 // everywhere gives L00 = 0.5 sqrt(4 pi) times light.environment.scale (the texels' solid angles
-// sum to 4 pi to 1e-12, tests/hdr) and the other coefficients 0 every frame, within 1e-3 of L00:
+// sum to 4 pi to 1e-12, tests/environment) and the other coefficients 0 every frame, within 1e-3 of L00:
 // each texel adds y_i at its centre times its exact solid angle, the midpoint rule, whose O(h^2)
 // error on the zonal l = 2 term is 2.3e-4 of L00 at 128 rows; a truncated file stops the daemon at
 // configure, naming the file and the key.

@@ -72,7 +72,7 @@ TEST(ProbeEstimator, MirrorDefaultEveryFrame) {
     EXPECT_TRUE(e.scene_linear);
     ASSERT_EQ(e.lights.size(), 1u);
     // Smoothed over frames whose truth moves by < 0.5 degree: same 2-degree bound (see
-    // test_probe_methods.cpp for the configured lamp distance).
+    // probe_methods_test.cpp for the configured lamp distance).
     EXPECT_LE(angle_deg(e.lights[0].direction_world, true_direction(gt, mirror_probe())), 2.0) << "frame " << i;
     EXPECT_GT(e.confidence, 0.5);
     EXPECT_LE(e.confidence, 1.0);

@@ -1,5 +1,5 @@
 // Frame timing and auto-exposure of the simulated camera: exact integer frame starts, raw
-// timestamps that normalise back exactly (DESIGN.md "Time"), and an AE loop that converges
+// timestamps that normalise back exactly (docs/DESIGN.md "Time"), and an AE loop that converges
 // within its limits.
 #include "capture/sim/exposure_control.h"
 

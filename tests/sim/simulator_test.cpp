@@ -366,7 +366,7 @@ TEST(Simulator, GroundTruthHasPosesLightsSunAndExposure) {
   EXPECT_NEAR(truth.sun->elevation_rad, 1.05, 1e-12);
   EXPECT_EQ(truth.exposure_ns, scene.camera.exposure_ns[0]);
   EXPECT_EQ(truth.exposure_ns, reader.metadata(1).exposure_ns);
-  // The metadata's exposure start comes back from the raw timestamp as DESIGN.md says.
+  // The metadata's exposure start comes back from the raw timestamp as docs/DESIGN.md says.
   const FrameMetadata& meta = reader.metadata(1);
   EXPECT_EQ(exposure_start_from_raw(meta.raw_timestamp_ns, meta.raw_timestamp_meaning, meta.exposure_ns,
                                     meta.readout_ns, meta.timestamp_offset_ns),
