@@ -7,11 +7,12 @@
 #include <string>
 #include <vector>
 
+#include "core/config/choice_names.h"
 #include "core/geometry/vec.h"
 
 namespace arpipe::calib {
 
-// Bad board file; what() reads "FILE:LINE:COL: key: what was wrong" where the place is known.
+// Bad board file; what() reads "FILE:LINE:COL: key: expected ..., found ..." (core/config/toml_section.h).
 class BoardError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
@@ -21,6 +22,8 @@ enum class BoardKind {
   chessboard,    // observed points: the inner corners
   apriltag_grid  // observed points: the tag centres (see docs/CALIBRATION.md for why not the corners)
 };
+inline constexpr ChoiceName<BoardKind> kBoardKindNames[] = {{"chessboard", BoardKind::chessboard},
+                                                           {"apriltag_grid", BoardKind::apriltag_grid}};
 
 struct CalibrationBoard {
   std::string name;         // from the file's stem

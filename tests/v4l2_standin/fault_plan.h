@@ -9,12 +9,14 @@
 #include <string_view>
 #include <vector>
 
+#include "core/config/choice_names.h"
+
 namespace arpipe::standin {
 
 enum class FaultKind { Unplug, Stall, Drop, ErrorBuffer, Eagain, Eio };
-
-std::string_view fault_kind_name(FaultKind kind);
-std::optional<FaultKind> fault_kind_from_name(std::string_view name);
+inline constexpr ChoiceName<FaultKind> kFaultKindNames[] = {
+    {"unplug", FaultKind::Unplug}, {"stall", FaultKind::Stall},   {"drop", FaultKind::Drop},
+    {"error_buffer", FaultKind::ErrorBuffer}, {"eagain", FaultKind::Eagain}, {"eio", FaultKind::Eio}};
 
 struct Fault {
   size_t frame = 0;  // 0-based recording frame

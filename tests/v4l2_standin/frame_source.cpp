@@ -47,6 +47,19 @@ OfferedFormat make_format(std::optional<PixelFormat> raw, bool native, const Rec
   return f;
 }
 
+// The pixel format a converted format offers (not Native or Mjpg).
+PixelFormat raw_format(OfferedFormatName format) {
+  switch (format) {
+    case OfferedFormatName::Yuyv: return PixelFormat::YUYV;
+    case OfferedFormatName::Rgb24: return PixelFormat::RGB24;
+    case OfferedFormatName::Grey: return PixelFormat::GREY;
+    case OfferedFormatName::Nv12: return PixelFormat::NV12;
+    case OfferedFormatName::Native:
+    case OfferedFormatName::Mjpg: break;
+  }
+  return PixelFormat::YUYV;  // not reached: the caller handles Native and Mjpg
+}
+
 }  // namespace
 
 FrameSource::FrameSource(const DeviceConfig& config) : config_(config) {
@@ -58,21 +71,19 @@ FrameSource::FrameSource(const DeviceConfig& config) : config_(config) {
   const RecordingInfo& info = reader_->info();
   if (reader_->frame_count() == 0)
     throw StandinConfigError(fmt::format("{}: recording \"{}\" has no frames", config.place, config.recording.string()));
-  for (const std::string& name : config.formats) {
+  for (const OfferedFormatName format : config.formats) {
+    const std::string_view name = choice_name<OfferedFormatName>(kOfferedFormatNames, format);
     OfferedFormat f;
-    if (name == "native") {
+    if (format == OfferedFormatName::Native) {
       f = make_format(info.pixel_format, true, info);
-    } else if (name == "MJPG") {
+    } else if (format == OfferedFormatName::Mjpg) {
       f = make_format(std::nullopt, false, info);
     } else {
-      const auto raw = pixel_format_from_name(name);
-      if (!raw)
-        throw StandinConfigError(fmt::format("{}: 'formats' expected \"native\", \"MJPG\", \"YUYV\", \"RGB24\", \"GREY\" or "
-                                             "\"NV12\", got \"{}\"", config.formats_place, name));
-      if (const auto bad = check_image_size(*raw, info.width, info.height))
+      const PixelFormat raw = raw_format(format);
+      if (const auto bad = check_image_size(raw, info.width, info.height))
         throw StandinConfigError(fmt::format("{}: format {} cannot carry the recording's {}x{} frames: {}",
                                              config.formats_place, name, info.width, info.height, *bad));
-      f = make_format(*raw, *raw == info.pixel_format, info);
+      f = make_format(raw, raw == info.pixel_format, info);
     }
     for (const OfferedFormat& other : formats_)
       if (other.fourcc == f.fourcc)

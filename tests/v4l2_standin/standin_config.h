@@ -7,26 +7,38 @@
 #include <string>
 #include <vector>
 
+#include "core/config/choice_names.h"
 #include "fault_plan.h"
 
 namespace arpipe::standin {
 
-// A bad configuration; what() starts with "file:line:column: ".
+// A bad configuration; what() reads "file:line:column: dotted.key: expected ..., found ..."
+// (core/config/toml_section.h), or another sentence after the place.
 class StandinConfigError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
 
 enum class Pacing { Realtime, Fast };
+inline constexpr ChoiceName<Pacing> kPacingNames[] = {{"realtime", Pacing::Realtime}, {"fast", Pacing::Fast}};
 enum class TimestampBase { Recorded, Live };
+inline constexpr ChoiceName<TimestampBase> kTimestampBaseNames[] = {{"recorded", TimestampBase::Recorded},
+                                                                    {"live", TimestampBase::Live}};
 enum class TimestampSource { StartOfExposure, EndOfFrame };
+inline constexpr ChoiceName<TimestampSource> kTimestampSourceNames[] = {{"soe", TimestampSource::StartOfExposure},
+                                                                        {"eof", TimestampSource::EndOfFrame}};
+// A format a device offers: the recording's own, JPEG-compressed, or converted to a pixel format.
+enum class OfferedFormatName { Native, Mjpg, Yuyv, Rgb24, Grey, Nv12 };
+inline constexpr ChoiceName<OfferedFormatName> kOfferedFormatNames[] = {
+    {"native", OfferedFormatName::Native}, {"MJPG", OfferedFormatName::Mjpg},  {"YUYV", OfferedFormatName::Yuyv},
+    {"RGB24", OfferedFormatName::Rgb24},   {"GREY", OfferedFormatName::Grey}, {"NV12", OfferedFormatName::Nv12}};
 
 struct DeviceConfig {
   std::string path;                   // absolute and lexically normal
   std::filesystem::path recording;    // absolute
   std::string card = "arpipe V4L2 stand-in";
   std::string bus_info;               // default "platform:arpipe-standin-<index>"
-  std::vector<std::string> formats = {"native", "MJPG"};
+  std::vector<OfferedFormatName> formats = {OfferedFormatName::Native, OfferedFormatName::Mjpg};
   Pacing pacing = Pacing::Realtime;
   TimestampBase timestamps = TimestampBase::Recorded;
   TimestampSource timestamp_source = TimestampSource::StartOfExposure;
