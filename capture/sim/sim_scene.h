@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "core/config/choice_names.h"
 #include "core/frame.h"
 #include "core/geometry/camera_model.h"
 #include "core/geometry/se3.h"
@@ -39,6 +40,10 @@ struct SimTexture {
   Rgb dark{0.03, 0.03, 0.03};
   Rgb light{0.80, 0.80, 0.80};
 };
+// texture.kind in a scene file (None: no [object.texture] table).
+inline constexpr ChoiceName<SimTexture::Kind> kSimTextureKindNames[] = {{"apriltag", SimTexture::Kind::AprilTag},
+                                                                        {"chessboard", SimTexture::Kind::Chessboard},
+                                                                        {"image", SimTexture::Kind::Image}};
 
 struct SimMaterial {
   enum class Kind { Lambertian, Mirror };
@@ -46,6 +51,8 @@ struct SimMaterial {
   Rgb albedo{0.5, 0.5, 0.5};  // Lambertian: diffuse reflectance; Mirror: specular reflectance
   SimTexture texture;         // Lambertian only; when set it replaces albedo (Image: multiplies)
 };
+inline constexpr ChoiceName<SimMaterial::Kind> kSimMaterialKindNames[] = {{"lambertian", SimMaterial::Kind::Lambertian},
+                                                                          {"mirror", SimMaterial::Kind::Mirror}};
 
 struct SimObject {
   enum class Shape { Plane, Sphere, Mesh };
@@ -62,6 +69,8 @@ struct SimObject {
   bool is_virtual = false;  // left out of the camera frames, drawn only in the ground-truth composite
   bool casts_shadows = true;
 };
+inline constexpr ChoiceName<SimObject::Shape> kSimShapeNames[] = {
+    {"plane", SimObject::Shape::Plane}, {"sphere", SimObject::Shape::Sphere}, {"mesh", SimObject::Shape::Mesh}};
 
 struct SimLight {
   enum class Kind { Directional, Point, Sphere };
@@ -80,6 +89,9 @@ struct SimLight {
   double radius_m = 0;  // Sphere only
   bool is_sun = false;  // made from the scene's [sun] table
 };
+inline constexpr ChoiceName<SimLight::Kind> kSimLightKindNames[] = {{"directional", SimLight::Kind::Directional},
+                                                                    {"point", SimLight::Kind::Point},
+                                                                    {"sphere", SimLight::Kind::Sphere}};
 
 // The sun of an outdoor scene: given as azimuth (east of true north) and elevation, so that a
 // test can compare an estimate against exactly these numbers. The loader turns it into a
@@ -125,6 +137,8 @@ struct SimTrajectory {
   std::vector<SimKeyframe> keyframes;  // one keyframe: a still camera
   SimRandomPath random;
 };
+inline constexpr ChoiceName<SimTrajectory::Kind> kSimTrajectoryKindNames[] = {
+    {"keyframes", SimTrajectory::Kind::Keyframes}, {"random", SimTrajectory::Kind::Random}};
 
 // The sensor: linear value = radiance * exposure (s) * sensitivity, in units of full scale (1.0 =
 // full well); photon shot noise at full_well_electrons, read noise in electrons, then analogue

@@ -10,7 +10,8 @@
 
 namespace arpipe::sim {
 
-// A bad scene file; what() reads "<file>:<line>:<col>: <key>: <what was expected>".
+// A bad scene file; what() reads "<file>:<line>:<col>: <dotted.key>: expected ..., found ..."
+// (core/config/toml_section.h).
 class SceneError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;

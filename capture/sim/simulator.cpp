@@ -39,20 +39,18 @@ std::vector<GroundTruthLight> ground_truth_lights(const SimScene& scene) {
     GroundTruthLight& out = lights.emplace_back();
     out.name = light.name;
     out.color = light.color;
+    out.kind = choice_name<SimLight::Kind>(kSimLightKindNames, light.kind);
     switch (light.kind) {
       case SimLight::Kind::Directional:
-        out.kind = "directional";
         out.direction_to_light = light.direction_to_light;
         out.strength = light.irradiance;
         out.angular_diameter_rad = light.angular_diameter_rad;
         break;
       case SimLight::Kind::Point:
-        out.kind = "point";
         out.position = light.position;
         out.strength = light.intensity;
         break;
       case SimLight::Kind::Sphere:
-        out.kind = "sphere";
         out.position = light.position;
         out.strength = light.intensity;
         out.radius_m = light.radius_m;

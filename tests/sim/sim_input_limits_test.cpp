@@ -139,7 +139,8 @@ TEST(SimInputLimits, SceneCountsAreCapped) {
   for (int i = 0; i < 10001; ++i) exposures += "1,";
   exposures += "]\n";
   EXPECT_TRUE(contains(scene_error(exposures, {}),
-                       "camera.exposure_ms: expected an array of at most 10000 numbers, found 10001 numbers"));
+                       "camera.exposure_ms: expected an array of at most 10000 numbers (a number > 0 each), found "
+                       "10001 numbers"));
 }
 
 TEST(SimInputLimits, AHugeHdrHeaderIsTheReadersErrorNotAnOpenCvAssertion) {
