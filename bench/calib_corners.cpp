@@ -2,18 +2,21 @@
 // (the finder's own corners, cornerSubPix, cornerSubPix + the X-junction model fit), with the time
 // per image. The capture must be the calib-board scene or share its board layout (9 x 13 inner
 // corners of 20 mm at x = -0.12 + 0.02 i, y = 0.08 - 0.02 j in the world).
-// Usage: calib_corners [--recording DIR] [--board FILE] [--dump FILE]   Prints a markdown table for
-// docs/BENCHMARKS.md. Defaults: build/calib-capture, configs/boards/chessboard-10x14-20mm.toml.
+// `arpipe bench calib-corners [--recording DIR] [--board FILE] [--dump FILE]` prints a markdown
+// table for docs/BENCHMARKS.md. Defaults: build/calib-capture, configs/boards/chessboard-10x14-20mm.toml.
 // --dump writes every corner (refinement, frame, point, true and detected pixel) as a vnl table.
 #include <fmt/format.h>
 
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "apps/cli/command_line.h"
+#include "bench/benchmarks.h"
 #include "calib/board_detector.h"
 #include "calib/calibration_board.h"
 #include "calib/calibration_images.h"
@@ -21,10 +24,10 @@
 #include "core/log.h"
 #include "core/pipeline/monotonic_clock.h"
 
-using namespace arpipe;
-using namespace arpipe::calib;
-
+namespace arpipe {
 namespace {
+
+using namespace arpipe::calib;
 
 std::vector<Vec3> board_corners_in_world() {
   std::vector<Vec3> out;
@@ -47,16 +50,14 @@ const char* name(CornerRefinement refinement) {
   return "?";
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+struct CornersOptions {
   std::string recording = "build/calib-capture", board_file = "configs/boards/chessboard-10x14-20mm.toml", dump_file;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string flag = argv[i];
-    if (flag == "--recording") recording = argv[i + 1];
-    else if (flag == "--board") board_file = argv[i + 1];
-    else if (flag == "--dump") dump_file = argv[i + 1];
-  }
+};
+
+int run_calib_corners_benchmark(const CornersOptions& options) {
+  const std::string& recording = options.recording;
+  const std::string& board_file = options.board_file;
+  const std::string& dump_file = options.dump_file;
   log::set_max_level(log::Level::Warning);
   try {
     RecordingReader reader(recording);
@@ -101,8 +102,24 @@ int main(int argc, char** argv) {
     }
     if (dump) std::fclose(dump);
   } catch (const std::exception& error) {
-    fmt::print(stderr, "calib_corners: {}\n", error.what());
+    fmt::print(stderr, "arpipe bench calib-corners: {}\n", error.what());
     return 1;
   }
   return 0;
 }
+
+}  // namespace
+
+void add_calib_corners_benchmark(CLI::App& bench) {
+  CLI::App* command = bench.add_subcommand(
+      "calib-corners", "chessboard corner accuracy against the simulator's truth for each corner refinement, with time");
+  auto options = std::make_shared<CornersOptions>();
+  command->add_option("--recording", options->recording, "the calib-board capture, or one with its board layout and truth")
+      ->type_name("DIR");
+  command->add_option("--board", options->board_file, "the board file")->type_name("FILE");
+  command->add_option("--dump", options->dump_file, "write every corner (refinement, frame, point, true and detected pixel) as a vnl table")
+      ->type_name("FILE");
+  cli::on_run(command, [options] { return run_calib_corners_benchmark(*options); });
+}
+
+}  // namespace arpipe

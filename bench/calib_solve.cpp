@@ -2,26 +2,28 @@
 // synthetic views of the calib-board scene's board through its wide OPENCV8 lens (analytic truth,
 // Gaussian corner noise), for LENSMODEL_OPENCV8 and the auto-configured splined model; plus the time
 // of the projection uncertainty the report computes (centre and four corners).
-// Usage: calib_solve [--sigma PX] [--seeds N]   Prints markdown tables for docs/BENCHMARKS.md.
+// `arpipe bench calib-solve [--sigma PX] [--seeds N]` prints markdown tables for docs/BENCHMARKS.md.
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "apps/cli/command_line.h"
+#include "bench/benchmarks.h"
 #include "calib/calibration_solver.h"
 #include "calib/projection_uncertainty.h"
 #include "core/log.h"
 #include "core/pipeline/monotonic_clock.h"
 #include "tests/calib/solver_test_support.h"
 
-using namespace arpipe;
-using namespace arpipe::calib;
-
+namespace arpipe {
 namespace {
+
+using namespace arpipe::calib;
 
 double median(std::vector<double> v) {
   std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
@@ -76,16 +78,7 @@ Row measure(const std::string& lensmodel, int views, double sigma, int seeds) {
   return row;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  double sigma = 0.1;
-  int seeds = 3;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string key = argv[i];
-    if (key == "--sigma") sigma = std::atof(argv[i + 1]);
-    if (key == "--seeds") seeds = std::max(1, std::atoi(argv[i + 1]));
-  }
+int run_calib_solve_benchmark(double sigma, int seeds) {
   log::set_max_level(log::Level::Warning);
   fmt::print(
       "Synthetic views: 640x480 OPENCV8 lens of configs/sim/calib-board.toml, 9x13-corner 20 mm board, tilted "
@@ -119,3 +112,22 @@ int main(int argc, char** argv) {
   }
   return 0;
 }
+
+}  // namespace
+
+void add_calib_solve_benchmark(CLI::App& bench) {
+  CLI::App* command = bench.add_subcommand(
+      "calib-solve", "the calibration solve's time and accuracy against the number of views, on synthetic views");
+  struct Options {
+    double sigma = 0.1;
+    int seeds = 3;
+  };
+  auto options = std::make_shared<Options>();
+  command->add_option("--sigma", options->sigma, "Gaussian corner noise per coordinate")
+      ->type_name("PX")
+      ->check(CLI::NonNegativeNumber);
+  command->add_option("--seeds", options->seeds, "noise seeds per row")->check(CLI::PositiveNumber);
+  cli::on_run(command, [options] { return run_calib_solve_benchmark(options->sigma, options->seeds); });
+}
+
+}  // namespace arpipe

@@ -1,45 +1,67 @@
 // The V4L2 capture path's cost per frame against a plain memory copy of the same frame, and the
 // latency from a frame's exposure end to its hand-off, measured through the V4L2 stand-in
-// (tests/v4l2_standin) serving a recording. Usage: capture_path [RECORDING] [--frames N]
+// (tests/v4l2_standin) serving a recording. `arpipe bench capture-path [RECORDING] [--frames N]`.
+// The stand-in must come before libc in the process: arpipe runs itself again with it preloaded.
 //
 // Per format the camera sends: the source's own work per frame, split into the buffer exchange
 // (DQBUF + QBUF: a syscall pair on hardware; through the stand-in, a function call plus whatever
 // frame it prepares then) and the copy or decode into the Frame with its metadata; the hand-off
 // into the pipeline's queue; and a memcpy of the same bytes, timed in the same run.
+#include <dlfcn.h>
 #include <sys/resource.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <cerrno>
+#include <cstdlib>
 #include <filesystem>
+#include <memory>
 #include <fstream>
 #include <string>
 #include <vector>
 
 #include <fmt/format.h>
 
+#include "apps/cli/command_line.h"
+#include "bench/benchmarks.h"
 #include "capture/live/live_source.h"
 #include "capture/recording/recording_reader.h"
 #include "core/frame_memory.h"
 #include "core/log.h"
 #include "core/pipeline/bounded_queue.h"
 #include "core/pipeline/monotonic_clock.h"
-#include "v4l2_standin.h"
+#include "tests/v4l2_standin/v4l2_standin.h"
 
-namespace fs = std::filesystem;
-using namespace arpipe;
-
+namespace arpipe {
 namespace {
 
+namespace fs = std::filesystem;
+
 constexpr const char* kDevice = "/dev/video-arpipe-bench";
+
+// The stand-in's C API, found in the process once the library is preloaded (null until then).
+struct Standin {
+  decltype(&arpipe_v4l2_standin_load) load = nullptr;
+  decltype(&arpipe_v4l2_standin_unload) unload = nullptr;
+};
+Standin g_standin;
+
+bool find_standin() {
+  g_standin.load = reinterpret_cast<decltype(&arpipe_v4l2_standin_load)>(dlsym(RTLD_DEFAULT, "arpipe_v4l2_standin_load"));
+  g_standin.unload =
+      reinterpret_cast<decltype(&arpipe_v4l2_standin_unload)>(dlsym(RTLD_DEFAULT, "arpipe_v4l2_standin_unload"));
+  return g_standin.load != nullptr && g_standin.unload != nullptr;
+}
 
 void load_standin(const fs::path& dir, const fs::path& recording, const std::string& keys) {
   const fs::path config = dir / "standin.toml";
   std::ofstream(config) << "[[device]]\npath = \"" << kDevice << "\"\nrecording = \"" << recording.string() << "\"\n"
                         << keys << "\n";
   char error[512] = {};
-  if (arpipe_v4l2_standin_load(config.c_str(), error, sizeof error) != 0)
+  if (g_standin.load(config.c_str(), error, sizeof error) != 0)
     throw std::runtime_error(fmt::format("stand-in: {}", error));
 }
 
@@ -109,7 +131,7 @@ Row measure(const fs::path& dir, const fs::path& recording, const std::string& c
   row.convert_us = double(after.convert_ns - before.convert_ns) / frames * 1e-3;
   row.handoff_us = double(handoff) / frames * 1e-3;
   row.memcpy_us = memcpy_ns(row.frame_bytes, frames) * 1e-3;
-  arpipe_v4l2_standin_unload();
+  g_standin.unload();
   return row;
 }
 
@@ -125,24 +147,49 @@ std::vector<double> latencies_ms(const fs::path& dir, const fs::path& recording,
     const auto& m = frame.meta;
     ms.push_back(double(handed_off - (m.exposure_start_ns + m.exposure_ns + m.readout_ns)) * 1e-6);
   }
-  arpipe_v4l2_standin_unload();
+  g_standin.unload();
   std::sort(ms.begin(), ms.end());
   return ms;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  log::set_program_name("capture_path");
-  keep_frame_memory_resident();  // as arpiped does
-  log::set_max_level(log::Level::Warning);
+struct CapturePathOptions {
   fs::path recording = fs::path(ARPIPE_BINARY_DIR) / "default-capture";
   int frames = 300;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--frames" && i + 1 < argc) frames = std::max(10, std::atoi(argv[++i]));
-    else recording = a;
+  fs::path standin = fs::path(ARPIPE_BINARY_DIR) / "tests" / "v4l2_standin" / "libarpipe-v4l2-standin.so";
+};
+
+// This arpipe again, the same benchmark, with the stand-in preloaded (LD_PRELOAD): its open, ioctl,
+// mmap and poll then come before libc's. Returns only when that fails.
+int run_again_with_standin(const CapturePathOptions& options) {
+  if (std::getenv("ARPIPE_BENCH_STANDIN_PRELOADED") != nullptr) {
+    fmt::print(stderr, "arpipe bench capture-path: {} was preloaded but its API is not in the process\n",
+               options.standin.string());
+    return 1;
   }
+  if (!fs::exists(options.standin)) {
+    fmt::print(stderr, "arpipe bench capture-path: no V4L2 stand-in at {} (it is built with the tests: "
+               "cmake --build build --target arpipe_v4l2_standin; or pass --standin LIB)\n", options.standin.string());
+    return 1;
+  }
+  const std::string preload = options.standin.string();
+  const char* before = std::getenv("LD_PRELOAD");
+  setenv("LD_PRELOAD", before && *before ? (preload + ":" + before).c_str() : preload.c_str(), 1);
+  setenv("ARPIPE_BENCH_STANDIN_PRELOADED", "1", 1);
+  const std::vector<std::string> args{"arpipe", "bench", "capture-path", options.recording.string(), "--frames",
+                                      std::to_string(options.frames), "--standin", preload};
+  std::vector<char*> argv;
+  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  execv("/proc/self/exe", argv.data());
+  fmt::print(stderr, "arpipe bench capture-path: cannot run arpipe again: {}\n", std::strerror(errno));
+  return 1;
+}
+
+int run_capture_path_benchmark(const CapturePathOptions& options) {
+  if (!find_standin()) return run_again_with_standin(options);
+  log::set_max_level(log::Level::Warning);
+  const fs::path& recording = options.recording;
+  const int frames = options.frames;
   try {
     const fs::path dir = fs::temp_directory_path() / fmt::format("arpipe-capture-path-{}", getpid());
     fs::create_directories(dir);
@@ -164,7 +211,21 @@ int main(int argc, char** argv) {
     fs::remove_all(dir);
     return 0;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "capture_path: %s\n", e.what());
+    std::fprintf(stderr, "arpipe bench capture-path: %s\n", e.what());
     return 1;
   }
 }
+
+}  // namespace
+
+void add_capture_path_benchmark(CLI::App& bench) {
+  CLI::App* command = bench.add_subcommand(
+      "capture-path", "the V4L2 capture path's cost per frame against a memcpy, and its latency, through the stand-in");
+  auto options = std::make_shared<CapturePathOptions>();
+  command->add_option("RECORDING", options->recording, "the recording the stand-in serves");
+  command->add_option("--frames", options->frames, "frames per format")->check(CLI::Range(10, 1000000));
+  command->add_option("--standin", options->standin, "the V4L2 stand-in library (docs/V4L2_STANDIN.md)")->type_name("LIB");
+  cli::on_run(command, [options] { return run_capture_path_benchmark(*options); });
+}
+
+}  // namespace arpipe

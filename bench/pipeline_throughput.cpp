@@ -1,7 +1,7 @@
 // Benchmark: per-stage time and frames per second of the embedded default scene and of
 // pass-through (no virtual object), and resident memory over a looped replay (soak).
-// Usage: pipeline_throughput [--capture DIR] [--frames N] [--soak-seconds S]
-// Prints a markdown table for docs/BENCHMARKS.md. Timings depend on the machine; compare the
+// `arpipe bench pipeline [--capture DIR] [--frames N] [--soak-seconds S]` prints a markdown table
+// for docs/BENCHMARKS.md. Timings depend on the machine; compare the
 // rows of one run with each other, not with another machine's.
 #include <fmt/format.h>
 #include <sys/utsname.h>
@@ -9,14 +9,16 @@
 #include <chrono>
 #include <cstdlib>
 #include <fstream>
+#include <memory>
 #include <string>
 #include <thread>
 
 #include "apps/common/pipeline_assembly.h"
+#include "apps/cli/command_line.h"
+#include "bench/benchmarks.h"
 #include "core/log.h"
 
-using namespace arpipe;
-
+namespace arpipe {
 namespace {
 
 long resident_kib() {
@@ -57,18 +59,16 @@ void print_row(const std::string& name, const PipelineMetrics& m) {
              stage_ms("render"), stage_ms("composite"));
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+struct PipelineOptions {
   std::string capture = "build/default-capture";
   int64_t frames = 600;
   int soak_seconds = 0;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string key = argv[i];
-    if (key == "--capture") capture = argv[i + 1];
-    else if (key == "--frames") frames = std::atoll(argv[i + 1]);
-    else if (key == "--soak-seconds") soak_seconds = std::atoi(argv[i + 1]);
-  }
+};
+
+int run_pipeline_benchmark(const PipelineOptions& options) {
+  const std::string& capture = options.capture;
+  const int64_t frames = options.frames;
+  const int soak_seconds = options.soak_seconds;
   log::set_max_level(log::Level::Warning);
   utsname u{};
   uname(&u);
@@ -104,3 +104,19 @@ int main(int argc, char** argv) {
   }
   return 0;
 }
+
+}  // namespace
+
+void add_pipeline_benchmark(CLI::App& bench) {
+  CLI::App* command = bench.add_subcommand(
+      "pipeline", "per-stage time and frames/s of the default scene and of pass-through; memory over a looped replay");
+  auto options = std::make_shared<PipelineOptions>();
+  command->add_option("--capture", options->capture, "the recording to replay")->type_name("DIR");
+  command->add_option("--frames", options->frames, "frames per measured run")->check(CLI::PositiveNumber);
+  command->add_option("--soak-seconds", options->soak_seconds, "then a looped replay this long, its memory every step (0: none)")
+      ->type_name("S")
+      ->check(CLI::NonNegativeNumber);
+  cli::on_run(command, [options] { return run_pipeline_benchmark(*options); });
+}
+
+}  // namespace arpipe

@@ -1,21 +1,23 @@
 // Benchmark: tracking run time against pose error, over a capture with ground truth, for the
 // detector's quad decimation and the corner refinement (the tracker's quality knobs).
-// Usage: pose_accuracy [--capture DIR]   Prints a markdown table for docs/BENCHMARKS.md.
+// `arpipe bench pose [--capture DIR]` prints a markdown table for docs/BENCHMARKS.md.
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "apps/cli/command_line.h"
+#include "bench/benchmarks.h"
 #include "capture/recording/recording_reader.h"
 #include "core/log.h"
 #include "core/pipeline/monotonic_clock.h"
 #include "core/track/tag_tracker.h"
 
-using namespace arpipe;
-
+namespace arpipe {
 namespace {
 
 struct Errors {
@@ -67,12 +69,7 @@ Errors measure(const RecordingReader& reader, const std::vector<Frame>& frames, 
   return e;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  std::string capture = "build/default-capture";
-  for (int i = 1; i + 1 < argc; i += 2)
-    if (std::string(argv[i]) == "--capture") capture = argv[i + 1];
+int run_pose_benchmark(const std::string& capture) {
   log::set_max_level(log::Level::Warning);
   try {
     RecordingReader reader(capture);
@@ -102,3 +99,15 @@ int main(int argc, char** argv) {
     return 2;
   }
 }
+
+}  // namespace
+
+void add_pose_benchmark(CLI::App& bench) {
+  CLI::App* command = bench.add_subcommand(
+      "pose", "tracking time against pose error for the detector's quad decimation and corner refinement");
+  auto capture = std::make_shared<std::string>("build/default-capture");
+  command->add_option("--capture", *capture, "a recording with ground truth")->type_name("DIR");
+  cli::on_run(command, [capture] { return run_pose_benchmark(*capture); });
+}
+
+}  // namespace arpipe

@@ -1,22 +1,24 @@
 // Benchmark: the light-probe analyses per frame (ProbeLightEstimator::update: region, decode and
 // method) on the probe-indoor capture, run time against light-direction error to the true key light.
-// Usage: probe_analysis [--capture DIR] [--repeats N]   Prints markdown tables for docs/BENCHMARKS.md.
+// `arpipe bench probe [--capture DIR] [--repeats N]` prints markdown tables for docs/BENCHMARKS.md.
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <numbers>
 #include <string>
 #include <vector>
 
+#include "apps/cli/command_line.h"
+#include "bench/benchmarks.h"
 #include "capture/recording/recording_reader.h"
 #include "core/image/pixel_convert.h"
 #include "core/probe/probe_light_estimator.h"
 #include "core/log.h"
 
-using namespace arpipe;
-
+namespace arpipe {
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -38,15 +40,7 @@ struct Row {
   double light_distance_m = 0;
 };
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  std::string capture = "build/probe-indoor-capture";
-  int repeats = 20;
-  for (int i = 1; i + 1 < argc; ++i) {
-    if (std::string(argv[i]) == "--capture") capture = argv[i + 1];
-    if (std::string(argv[i]) == "--repeats") repeats = std::max(1, std::atoi(argv[i + 1]));
-  }
+int run_probe_benchmark(const std::string& capture, int repeats) {
   try {
     RecordingReader reader(capture);
     const auto& truth = reader.ground_truth();
@@ -131,3 +125,20 @@ int main(int argc, char** argv) {
   }
   return 0;
 }
+
+}  // namespace
+
+void add_probe_benchmark(CLI::App& bench) {
+  CLI::App* command = bench.add_subcommand(
+      "probe", "the light-probe analyses per frame: run time against light-direction error to the true key light");
+  struct Options {
+    std::string capture = "build/probe-indoor-capture";
+    int repeats = 20;
+  };
+  auto options = std::make_shared<Options>();
+  command->add_option("--capture", options->capture, "the probe-indoor capture (or one like it)")->type_name("DIR");
+  command->add_option("--repeats", options->repeats, "runs over the capture per row")->check(CLI::PositiveNumber);
+  cli::on_run(command, [options] { return run_probe_benchmark(options->capture, options->repeats); });
+}
+
+}  // namespace arpipe

@@ -3,29 +3,31 @@
 // same frame, both clipped at full scale as the sensor clips them (a light seen directly or in a
 // mirror is thousands of times full scale and would otherwise swamp everything), relative to the
 // reference's mean (so scenes of any brightness compare).
-// Usage: sim_render_speed [--scenes DIR] [--samples 1,4,16] [--reference 256] [--frames N] [--threads N]
-// Prints a markdown table for docs/BENCHMARKS.md.
+// `arpipe bench sim-render [--scenes DIR] [--samples 1,4,16] [--reference 256] [--frames N] [--threads N]`
+// prints a markdown table for docs/BENCHMARKS.md.
 #include <fmt/format.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <memory>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
-#include <sstream>
 #include <string>
 #include <vector>
 
+#include "apps/cli/command_line.h"
+#include "bench/benchmarks.h"
 #include "capture/recording/recording_reader.h"
 #include "capture/sim/sim_scene_loader.h"
 #include "capture/sim/simulator.h"
 #include "core/log.h"
 
-using namespace arpipe;
-namespace fs = std::filesystem;
-
+namespace arpipe {
 namespace {
+
+namespace fs = std::filesystem;
 
 struct Run {
   double seconds_per_frame = 0;  // rendering, sensor and writing, without the one-off setup
@@ -66,32 +68,16 @@ double relative_rms(const std::vector<cv::Mat>& images, const std::vector<cv::Ma
   return std::sqrt(squared / count) / (mean / count);
 }
 
-std::vector<int> parse_list(const std::string& text) {
-  std::vector<int> values;
-  std::stringstream in(text);
-  for (std::string item; std::getline(in, item, ',');) values.push_back(std::stoi(item));
-  return values;
-}
-
-}  // namespace
-
-int main(int argc, char** argv) {
-  log::set_program_name("sim_render_speed");
+struct SimRenderOptions {
   fs::path scenes_dir = "configs/sim";
   std::vector<int> samples{1, 4, 16};
   int reference_samples = 256, frames = 2, threads = 0;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string key = argv[i], value = argv[i + 1];
-    if (key == "--scenes") scenes_dir = value;
-    else if (key == "--samples") samples = parse_list(value);
-    else if (key == "--reference") reference_samples = std::stoi(value);
-    else if (key == "--frames") frames = std::stoi(value);
-    else if (key == "--threads") threads = std::stoi(value);
-    else {
-      fmt::print(stderr, "unknown option {}\n", key);
-      return 2;
-    }
-  }
+};
+
+int run_sim_render_benchmark(const SimRenderOptions& options) {
+  const fs::path& scenes_dir = options.scenes_dir;
+  const std::vector<int>& samples = options.samples;
+  const int reference_samples = options.reference_samples, frames = options.frames, threads = options.threads;
   std::vector<fs::path> scene_files;
   for (const auto& entry : fs::directory_iterator(scenes_dir))
     if (entry.path().extension() == ".toml") scene_files.push_back(entry.path());
@@ -119,3 +105,24 @@ int main(int argc, char** argv) {
   }
   return 0;
 }
+
+}  // namespace
+
+void add_sim_render_benchmark(CLI::App& bench) {
+  CLI::App* command = bench.add_subcommand(
+      "sim-render", "the simulator's seconds per frame against its Monte-Carlo error, per scene and samples per pixel");
+  auto options = std::make_shared<SimRenderOptions>();
+  command->add_option("--scenes", options->scenes_dir, "every .toml scene in DIR")->type_name("DIR");
+  command->add_option("--samples", options->samples, "samples per pixel, a comma-separated list")
+      ->type_name("N,N,...")
+      ->delimiter(',')
+      ->allow_extra_args(false)
+      ->check(CLI::PositiveNumber);
+  command->add_option("--reference", options->reference_samples, "samples per pixel of the reference")
+      ->check(CLI::PositiveNumber);
+  command->add_option("--frames", options->frames, "frames per scene")->check(CLI::PositiveNumber);
+  command->add_option("--threads", options->threads, "render threads (0: every core)")->check(CLI::NonNegativeNumber);
+  cli::on_run(command, [options] { return run_sim_render_benchmark(*options); });
+}
+
+}  // namespace arpipe

@@ -1,24 +1,24 @@
 // Benchmark: run time per call of the sun-position algorithms (NREL SPA, seed 001's PSA) and of
-// the direction into the anchor frame. Usage: sun_position [--calls N] [--repeats R]
+// the direction into the anchor frame. `arpipe bench sun [--calls N] [--repeats R]`
 // Prints ns per call, the median over R repeats of N calls each, with PSA's error against SPA.
-// (A plain timing main: bench/CMakeLists.txt does not link Google Benchmark.)
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
 
+#include "apps/cli/command_line.h"
+#include "bench/benchmarks.h"
 #include "core/sun/civil_time.h"
 #include "core/sun/sun_direction.h"
 #include "core/sun/sun_position_psa.h"
 #include "core/sun/sun_position_spa.h"
 
-using namespace arpipe;
-
+namespace arpipe {
 namespace {
 
 struct Sample {
@@ -39,15 +39,7 @@ double median_ns_per_call(int calls, int repeats, F&& f) {
   return ns[ns.size() / 2];
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  int calls = 20000, repeats = 15;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string a = argv[i];
-    if (a == "--calls") calls = std::max(1, std::atoi(argv[i + 1]));
-    else if (a == "--repeats") repeats = std::max(1, std::atoi(argv[i + 1]));
-  }
+int run_sun_benchmark(int calls, int repeats) {
   std::mt19937_64 rng(1);
   std::uniform_real_distribution<double> lat(-80, 80), lon(-180, 180);
   std::uniform_int_distribution<int64_t> secs(946684800, 2556143999);  // 2000..2050
@@ -92,3 +84,19 @@ int main(int argc, char** argv) {
   fmt::print("| sun_in_world (ENU -> anchor) | {:.0f} | - |\n", dir_ns);
   return sink == 12345.678 ? 1 : 0;
 }
+
+}  // namespace
+
+void add_sun_benchmark(CLI::App& bench) {
+  CLI::App* command = bench.add_subcommand(
+      "sun", "run time per call of the sun-position algorithms (NREL SPA, PSA), PSA's error against SPA");
+  struct Options {
+    int calls = 20000, repeats = 15;
+  };
+  auto options = std::make_shared<Options>();
+  command->add_option("--calls", options->calls, "calls per timed repeat")->check(CLI::PositiveNumber);
+  command->add_option("--repeats", options->repeats, "timed repeats (the median is printed)")->type_name("R")->check(CLI::PositiveNumber);
+  cli::on_run(command, [options] { return run_sun_benchmark(options->calls, options->repeats); });
+}
+
+}  // namespace arpipe

@@ -11,6 +11,8 @@ packages=(
   libmrgingham-dev libeigen3-dev libsuitesparse-dev
   libtomlplusplus-dev nlohmann-json3-dev libsystemd-dev libfmt-dev
   libgeographiclib-dev
+  # the command lines of arpipe and arpiped (header-only)
+  libcli11-dev
   # HDR light probes (OpenEXR) and the PRT cache's content key (xxHash)
   libopenexr-dev libxxhash-dev
   # live cameras: libcamera (ISP pipelines, Raspberry Pi), libjpeg-turbo (MJPEG from UVC webcams)

@@ -5,12 +5,14 @@
 #include <cstdio>
 #include <exception>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "apps/arpipe/commands.h"
-#include "apps/arpipe/progress_bar.h"
+#include "apps/cli/command_line.h"
+#include "apps/cli/progress_bar.h"
 #include "core/sh/sh_basis.h"
 #include "core/scene/asset_error.h"
 #include "core/scene/builtin_meshes.h"
@@ -23,74 +25,19 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr const char* kUsage =
-    "usage: arpipe bake MODEL [--kind unshadowed|shadowed|interreflected] [--bands N] [--samples N]\n"
-    "                         [--cache-dir DIR] [--force]\n"
-    "  MODEL          a glTF file (.gltf, .glb) or a builtin mesh (builtin:cube, builtin:pyramid, ...)\n"
-    "  --kind K       transfer: unshadowed (no rays), shadowed (default) or interreflected\n"
-    "                 (shadowed plus one grey diffuse bounce)\n"
-    "  --bands N      SH bands, N^2 coefficients per vertex (default 3)\n"
-    "  --samples N    sphere samples per axis: N x N jittered directions (default 32)\n"
-    "  --cache-dir D  the PRT cache (default $XDG_CACHE_HOME/arpipe/prt or ~/.cache/arpipe/prt)\n"
-    "  --force        bake even when the cache holds an up-to-date result\n";
-
-int parse_int(const std::string& option, const std::string& text, int lo, int hi) {
-  size_t used = 0;
-  int value = 0;
-  try {
-    value = std::stoi(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used != text.size() || text.empty() || value < lo || value > hi)
-    throw std::invalid_argument(fmt::format("{} needs an integer in [{}, {}], got \"{}\"", option, lo, hi, text));
-  return value;
-}
-
-}  // namespace
-
-int run_bake(const Args& args) {
-  std::string model;
+struct BakeOptions {
+  std::string model, kind = "shadowed";
   PrtBakeSettings settings;
   fs::path cache_dir;
   bool force = false;
-  try {
-    for (size_t i = 0; i < args.size(); ++i) {
-      const auto value = [&]() -> const std::string& {
-        if (i + 1 >= args.size()) throw std::invalid_argument(fmt::format("{} needs a value", args[i]));
-        return args[++i];
-      };
-      const std::string& arg = args[i];
-      if (arg == "--kind") {
-        const std::string& name = value();
-        const std::optional<TransferKind> kind = parse_transfer_kind(name);
-        if (!kind)
-          throw std::invalid_argument(
-              fmt::format("--kind must be unshadowed, shadowed or interreflected, got \"{}\"", name));
-        settings.kind = *kind;
-      } else if (arg == "--bands") {
-        settings.bands = parse_int(arg, value(), 1, kMaxShBands);
-      } else if (arg == "--samples") {
-        settings.samples_per_axis = parse_int(arg, value(), 1, 4096);
-      } else if (arg == "--cache-dir") {
-        cache_dir = value();
-        if (cache_dir.empty()) throw std::invalid_argument("--cache-dir needs a directory");
-      } else if (arg == "--force") {
-        force = true;
-      } else if (arg == "--help" || arg == "-h") {
-        std::fputs(kUsage, stdout);
-        return 0;
-      } else if (arg.starts_with("--") || !model.empty()) {
-        throw std::invalid_argument(fmt::format("unknown argument \"{}\"", arg));
-      } else {
-        model = arg;
-      }
-    }
-    if (model.empty()) throw std::invalid_argument("which MODEL?");
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "arpipe bake: %s\n%s", e.what(), kUsage);
-    return 2;
-  }
+};
+
+int bake(BakeOptions options) {
+  const std::string& model = options.model;
+  PrtBakeSettings& settings = options.settings;
+  settings.kind = *parse_transfer_kind(options.kind);  // checked when read
+  fs::path& cache_dir = options.cache_dir;
+  const bool force = options.force;
   if (cache_dir.empty()) cache_dir = default_prt_cache_dir();
   if (cache_dir.empty()) {
     std::fprintf(stderr, "arpipe bake: no cache directory: neither XDG_CACHE_HOME nor HOME is set; pass --cache-dir\n");
@@ -145,6 +92,31 @@ int run_bake(const Args& args) {
     return 1;
   }
   return 0;
+}
+
+}  // namespace
+
+void add_bake_command(CLI::App& arpipe) {
+  CLI::App* command =
+      arpipe.add_subcommand("bake", "precompute a mesh's radiance transfer (PRT) into the cache the renderer reads");
+  auto options = std::make_shared<BakeOptions>();
+  command->add_option("MODEL", options->model, "a glTF file (.gltf, .glb) or a builtin mesh (builtin:cube, builtin:pyramid, ...)")
+      ->required();
+  command->add_option("--kind", options->kind,
+                      "transfer: unshadowed (no rays), shadowed or interreflected (shadowed plus one grey diffuse bounce)")
+      ->type_name("K")
+      ->check(cli::accepted_by([](const std::string& t) { return parse_transfer_kind(t).has_value(); },
+                               "unshadowed, shadowed or interreflected"));
+  command->add_option("--bands", options->settings.bands, "SH bands, N^2 coefficients per vertex")
+      ->check(CLI::Range(1, kMaxShBands));
+  command->add_option("--samples", options->settings.samples_per_axis, "sphere samples per axis: N x N jittered directions")
+      ->check(CLI::Range(1, 4096));
+  command->add_option("--cache-dir", options->cache_dir, "the PRT cache")
+      ->type_name("DIR")
+      ->default_str("$XDG_CACHE_HOME/arpipe/prt or ~/.cache/arpipe/prt")
+      ->check(cli::accepted_by([](const std::string& t) { return !t.empty(); }, "a directory"));
+  command->add_flag("--force", options->force, "bake even when the cache holds an up-to-date result");
+  cli::on_run(command, [options] { return bake(*options); });
 }
 
 }  // namespace arpipe

@@ -1,19 +1,26 @@
-// arpipe bench NAME: the benchmarks that run the real pipeline parts (more live in build/bench/).
-#include <fmt/format.h>
-
+// arpipe bench NAME: every benchmark (bench/), or, in a build without them, a message that says so.
 #include <cstdio>
 
 #include "apps/arpipe/commands.h"
+#include "apps/cli/command_line.h"
+#ifdef ARPIPE_WITH_BENCHMARKS
+#include "bench/benchmarks.h"
+#endif
 
 namespace arpipe {
 
-int run_bench(const Args& args) {
-  if (!args.empty() && args[0] == "blur") return run_bench_blur(Args(args.begin() + 1, args.end()));
-  if (!args.empty() && args[0] == "shadows") return run_bench_shadows(Args(args.begin() + 1, args.end()));
-  if (!args.empty() && args[0] == "sh") return run_bench_sh(Args(args.begin() + 1, args.end()));
-  if (!args.empty() && args[0] == "prt") return run_bench_prt(Args(args.begin() + 1, args.end()));
-  std::fputs("usage: arpipe bench blur|shadows|sh|prt [OPTIONS]   (arpipe bench NAME --help for the options)\n", stderr);
-  return 2;
+void add_bench_command(CLI::App& arpipe) {
+  CLI::App* bench = arpipe.add_subcommand("bench", "run a benchmark: time against error (docs/BENCHMARKS.md)");
+#ifdef ARPIPE_WITH_BENCHMARKS
+  bench->require_subcommand(1);
+  add_benchmarks(*bench);
+#else
+  bench->prefix_command();  // whatever follows is the benchmark's: not a usage error of its own
+  cli::on_run(bench, [] {
+    std::fputs("arpipe bench: this arpipe was built without the benchmarks (cmake -DARPIPE_BUILD_BENCH=OFF)\n", stderr);
+    return 2;
+  });
+#endif
 }
 
 }  // namespace arpipe

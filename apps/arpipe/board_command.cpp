@@ -1,11 +1,13 @@
 // arpipe board: writes the printable picture of a calibration board file (configs/boards/).
 #include <fmt/format.h>
 
-#include <charconv>
 #include <cstdio>
 #include <exception>
+#include <memory>
+#include <string>
 
 #include "apps/arpipe/commands.h"
+#include "apps/cli/command_line.h"
 #include "calib/board_printout.h"
 #include "calib/calibration_board.h"
 #include "core/log.h"
@@ -13,48 +15,16 @@
 namespace arpipe {
 
 namespace {
-constexpr const char* kUsage =
-    "usage: arpipe board FILE --out BOARD.png [--dpi N]\n"
-    "  Draws the board that FILE (configs/boards/*.toml) describes, at N pixels per inch (default 300).\n"
-    "  Print it at that resolution and 100 % scale (not fitted to the page), glue it to something flat\n"
-    "  and rigid, then measure a square or a tag and correct the board file if the printer scaled it.\n";
-}  // namespace
 
-int run_board(const Args& args) {
-  std::string board_path;
-  std::string out;
+struct BoardOptions {
+  std::string board_path, out;
   double dpi = 300;
-  for (size_t i = 0; i < args.size(); ++i) {
-    if (args[i] == "--help" || args[i] == "-h") {
-      std::fputs(kUsage, stdout);
-      return 0;
-    }
-    if (args[i] == "--out" || args[i] == "--dpi") {
-      if (i + 1 >= args.size()) {
-        fmt::print(stderr, "arpipe board: {} needs a value\n{}", args[i], kUsage);
-        return 2;
-      }
-      const std::string& value = args[++i];
-      if (args[i - 1] == "--out") {
-        out = value;
-      } else {
-        const auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), dpi);
-        if (ec != std::errc() || end != value.data() + value.size()) {
-          fmt::print(stderr, "arpipe board: bad value '{}' for --dpi\n{}", value, kUsage);
-          return 2;
-        }
-      }
-    } else if (board_path.empty() && args[i].rfind("--", 0) != 0) {
-      board_path = args[i];
-    } else {
-      fmt::print(stderr, "arpipe board: unexpected argument {}\n{}", args[i], kUsage);
-      return 2;
-    }
-  }
-  if (board_path.empty() || out.empty()) {
-    fmt::print(stderr, "arpipe board: a board file and --out are required\n{}", kUsage);
-    return 2;
-  }
+};
+
+int draw_board(const BoardOptions& options) {
+  const std::string& board_path = options.board_path;
+  const std::string& out = options.out;
+  const double dpi = options.dpi;
   try {
     const calib::CalibrationBoard board = calib::load_board(board_path);
     const calib::PrintedBoard printed = calib::write_board_png(board, out, dpi);
@@ -67,6 +37,20 @@ int run_board(const Args& args) {
     log::error("{}", e.what());
     return 1;
   }
+}
+
+}  // namespace
+
+void add_board_command(CLI::App& arpipe) {
+  CLI::App* command = arpipe.add_subcommand("board", "draw a board file's printable picture");
+  command->footer(
+      "Print it at that resolution and 100 % scale (not fitted to the page), glue it to something flat and rigid,\n"
+      "then measure a square or a tag and correct the board file if the printer scaled it.");
+  auto options = std::make_shared<BoardOptions>();
+  command->add_option("FILE", options->board_path, "the board file (configs/boards/*.toml)")->required();
+  command->add_option("--out", options->out, "the picture")->type_name("BOARD.png")->required();
+  command->add_option("--dpi", options->dpi, "pixels per inch")->check(CLI::PositiveNumber);
+  cli::on_run(command, [options] { return draw_board(*options); });
 }
 
 }  // namespace arpipe

@@ -3,15 +3,16 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <charconv>
 #include <cstdio>
 #include <exception>
 #include <fstream>
+#include <memory>
 #include <optional>
 #include <thread>
 
 #include "apps/arpipe/commands.h"
-#include "apps/arpipe/progress_bar.h"
+#include "apps/cli/command_line.h"
+#include "apps/cli/progress_bar.h"
 #include "calib/calibration_board.h"
 #include "calib/calibration_images.h"
 #include "calib/calibration_report.h"
@@ -24,21 +25,6 @@
 namespace arpipe {
 
 namespace {
-constexpr const char* kUsage =
-    "usage: arpipe calib (--images 'GLOB' | --recording DIR) --board FILE --out CAMERA.cameramodel\n"
-    "                    [--lensmodel NAME] [--focal PX] [--threads N] [--no-warp]\n"
-    "  Finds the board (configs/boards/*.toml) in every image, solves the lens with mrcal and writes\n"
-    "  CAMERA.cameramodel, and beside it CAMERA.report.txt, CAMERA.report.json, CAMERA.residuals.png\n"
-    "  and CAMERA.corners.vnl (mrcal's corners cache). docs/CALIBRATION.md says how to take the images.\n"
-    "  --lensmodel: LENSMODEL_OPENCV8 (default), OPENCV4, OPENCV5, PINHOLE, SPLINED_STEREOGRAPHIC\n"
-    "               (configured automatically) or a full mrcal name; the LENSMODEL_ prefix is optional.\n"
-    "  --focal: a focal-length guess in pixels (default: found from the views).\n";
-
-template <typename T>
-bool parse_number(const std::string& text, T& out) {
-  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), out);
-  return ec == std::errc() && end == text.data() + text.size();
-}
 
 std::filesystem::path beside(const std::filesystem::path& model, const std::string& suffix) {
   std::filesystem::path p = model;
@@ -55,52 +41,21 @@ void write_text(const std::filesystem::path& path, const std::string& text) {
   }
   std::filesystem::rename(temporary, path);
 }
-}  // namespace
-
-int run_calib(const Args& args) {
+struct CalibOptions {
   std::string images_glob;
-  std::filesystem::path recording;
-  std::filesystem::path board_path;
-  std::filesystem::path out;
-  calib::SolveOptions options;
+  std::filesystem::path recording, board_path, out;
+  calib::SolveOptions solve;
   int threads = int(std::max(1u, std::thread::hardware_concurrency()));
-  for (size_t i = 0; i < args.size(); ++i) {
-    if (args[i] == "--help" || args[i] == "-h") {
-      std::fputs(kUsage, stdout);
-      return 0;
-    }
-    if (args[i] == "--no-warp") {
-      options.optimize_board_warp = false;
-      continue;
-    }
-    if (i + 1 >= args.size()) {
-      fmt::print(stderr, "arpipe calib: {} needs a value\n{}", args[i], kUsage);
-      return 2;
-    }
-    const std::string& key = args[i];
-    const std::string& value = args[++i];
-    bool ok = true;
-    if (key == "--images") images_glob = value;
-    else if (key == "--recording") recording = value;
-    else if (key == "--board") board_path = value;
-    else if (key == "--out") out = value;
-    else if (key == "--lensmodel") options.lensmodel = value.rfind("LENSMODEL_", 0) == 0 ? value : "LENSMODEL_" + value;
-    else if (key == "--focal") ok = parse_number(value, options.focal_guess_px) && options.focal_guess_px > 0;
-    else if (key == "--threads") ok = parse_number(value, threads) && threads > 0;
-    else {
-      fmt::print(stderr, "arpipe calib: unknown option {}\n{}", key, kUsage);
-      return 2;
-    }
-    if (!ok) {
-      fmt::print(stderr, "arpipe calib: bad value '{}' for {}\n{}", value, key, kUsage);
-      return 2;
-    }
-  }
-  if (images_glob.empty() == recording.empty() || board_path.empty() || out.empty()) {
-    fmt::print(stderr, "arpipe calib: give one of --images and --recording, and --board and --out\n{}", kUsage);
-    return 2;
-  }
+};
 
+int calibrate(const CalibOptions& command) {
+  const std::string& images_glob = command.images_glob;
+  const std::filesystem::path& recording = command.recording;
+  const std::filesystem::path& board_path = command.board_path;
+  const std::filesystem::path& out = command.out;
+  calib::SolveOptions options = command.solve;
+  if (options.lensmodel.rfind("LENSMODEL_", 0) != 0) options.lensmodel = "LENSMODEL_" + options.lensmodel;
+  const int threads = command.threads;
   try {
     const calib::CalibrationBoard board = calib::load_board(board_path);
     const auto images = images_glob.empty() ? calib::images_from_recording(recording)
@@ -139,6 +94,42 @@ int run_calib(const Args& args) {
     log::error("{}", e.what());
     return 1;
   }
+}
+
+}  // namespace
+
+void add_calib_command(CLI::App& arpipe) {
+  CLI::App* command = arpipe.add_subcommand(
+      "calib", "calibrate a camera's lens with mrcal from views of a board (configs/boards/), with a report");
+  command->footer(
+      "Finds the board in every image, solves the lens with mrcal and writes CAMERA.cameramodel, and beside it\n"
+      "CAMERA.report.txt, CAMERA.report.json, CAMERA.residuals.png and CAMERA.corners.vnl (mrcal's corners\n"
+      "cache). docs/CALIBRATION.md says how to take the images.");
+  auto options = std::make_shared<CalibOptions>();
+  CLI::Option* images = command->add_option("--images", options->images_glob, "the images (quote the pattern)")
+                            ->type_name("GLOB");
+  CLI::Option* recording = command->add_option("--recording", options->recording, "a recording's frames")
+                               ->type_name("DIR");
+  images->excludes(recording);
+  command->add_option("--board", options->board_path, "the board file (configs/boards/*.toml)")
+      ->type_name("FILE")
+      ->required();
+  command->add_option("--out", options->out, "the camera model to write")->type_name("CAMERA.cameramodel")->required();
+  command->add_option("--lensmodel", options->solve.lensmodel,
+                      "OPENCV8, OPENCV4, OPENCV5, PINHOLE, SPLINED_STEREOGRAPHIC (configured automatically) or a full "
+                      "mrcal name; the LENSMODEL_ prefix is optional")
+      ->type_name("NAME");
+  command->add_option("--focal", options->solve.focal_guess_px, "a focal-length guess in pixels")
+      ->type_name("PX")
+      ->check(CLI::PositiveNumber)
+      ->default_str("found from the views");
+  command->add_option("--threads", options->threads, "detection threads")->check(CLI::PositiveNumber);
+  command->add_flag_function("--no-warp", [options](int64_t) { options->solve.optimize_board_warp = false; },
+                             "do not solve for the board's warp");
+  cli::on_run(command, [options, images, recording] {
+    if (!*images && !*recording) cli::usage_error("give one of --images and --recording");
+    return calibrate(*options);
+  });
 }
 
 }  // namespace arpipe

@@ -4,24 +4,25 @@
 #include <algorithm>
 #include <cstdio>
 #include <exception>
+#include <memory>
+#include <string>
 
 #include "apps/arpipe/commands.h"
+#include "apps/cli/command_line.h"
 #include "capture/recording/recording_reader.h"
 #include "core/log.h"
 
 namespace arpipe {
 
-int run_inspect(const Args& args) {
-  if (args.size() != 1) {
-    std::fputs("usage: arpipe inspect DIR\n", stderr);
-    return 2;
-  }
+namespace {
+
+int inspect(const std::string& dir) {
   try {
-    RecordingReader reader(args[0]);
+    RecordingReader reader(dir);
     for (const auto& w : reader.warnings()) log::warn("{}", w);
     const auto& info = reader.info();
     const auto& model = reader.camera_model();
-    fmt::print("recording    {}\n", args[0]);
+    fmt::print("recording    {}\n", dir);
     fmt::print("format       v{}, {} {}x{}, {} bytes per line\n", info.version, pixel_format_name(info.pixel_format),
                info.width, info.height, info.bytes_per_line);
     fmt::print("source       {}\n", info.source);
@@ -57,7 +58,7 @@ int run_inspect(const Args& args) {
     fmt::print("timestamps   {} (offset {} ns)\n", timestamp_meaning_name(first.raw_timestamp_meaning),
                first.timestamp_offset_ns);
     if (backwards) {
-      log::warn("{}: {} frame(s) do not advance in time", args[0], backwards);
+      log::warn("{}: {} frame(s) do not advance in time", dir, backwards);
       return 1;
     }
     return 0;
@@ -65,6 +66,15 @@ int run_inspect(const Args& args) {
     log::error("{}", e.what());
     return 2;
   }
+}
+
+}  // namespace
+
+void add_inspect_command(CLI::App& arpipe) {
+  CLI::App* command = arpipe.add_subcommand("inspect", "summary of a recording: frames, format, timing, drops");
+  auto dir = std::make_shared<std::string>();
+  command->add_option("DIR", *dir, "the recording")->required();
+  cli::on_run(command, [dir] { return inspect(*dir); });
 }
 
 }  // namespace arpipe

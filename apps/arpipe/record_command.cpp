@@ -3,11 +3,14 @@
 #include <atomic>
 #include <csignal>
 #include <cstdio>
+#include <memory>
 #include <string>
+#include <vector>
 
 #include <fmt/format.h>
 
 #include "apps/arpipe/commands.h"
+#include "apps/cli/command_line.h"
 #include "capture/live/live_source.h"
 #include "capture/recording/recording_writer.h"
 #include "core/config/config.h"
@@ -17,12 +20,6 @@
 namespace arpipe {
 
 namespace {
-
-constexpr const char* kUsage =
-    "usage: arpipe record --camera CAMERA --out DIR [--frames N | --seconds S] [--config FILE]\n"
-    "                     [--width W --height H] [--fps F] [--format YUYV|NV12|RGB24|GREY|MJPG]\n"
-    "                     [--exposure-us US] [--gain G] [--camera-model FILE] [--set KEY=VALUE]...\n"
-    "  CAMERA: /dev/videoN, a /dev/v4l/by-id link, v4l2:PATH, or libcamera:ID|INDEX\n";
 
 std::atomic<bool> g_stop{false};
 void on_signal(int) { g_stop = true; }
@@ -47,44 +44,24 @@ CameraModel nominal_model(int width, int height) {
   return CameraModel::pinhole(width, width, (width - 1) / 2.0, (height - 1) / 2.0, width, height);
 }
 
-}  // namespace
-
-int run_record(const Args& args) {
+struct RecordOptions {
   std::string camera, out, config_path, model_path;
   int64_t frames = 0;
   double seconds = 0;
-  std::vector<std::string> overrides;
-  for (size_t i = 0; i < args.size(); ++i) {
-    const bool has_value = i + 1 < args.size();
-    const std::string& a = args[i];
-    try {
-      if (a == "--camera" && has_value) camera = args[++i];
-      else if (a == "--out" && has_value) out = args[++i];
-      else if (a == "--frames" && has_value) frames = std::stoll(args[++i]);
-      else if (a == "--seconds" && has_value) seconds = std::stod(args[++i]);
-      else if (a == "--config" && has_value) config_path = args[++i];
-      else if (a == "--camera-model" && has_value) model_path = args[++i];
-      else if (a == "--width" && has_value) overrides.push_back("source.width=" + std::to_string(std::stoi(args[++i])));
-      else if (a == "--height" && has_value) overrides.push_back("source.height=" + std::to_string(std::stoi(args[++i])));
-      else if (a == "--fps" && has_value) overrides.push_back(fmt::format("source.fps={}", std::stod(args[++i])));
-      else if (a == "--format" && has_value) overrides.push_back("source.pixel_format=" + toml_string(args[++i]));
-      else if (a == "--exposure-us" && has_value) overrides.push_back("source.exposure_us=" + std::to_string(std::stoll(args[++i])));
-      else if (a == "--gain" && has_value) overrides.push_back(fmt::format("source.gain={}", std::stod(args[++i])));
-      else if (a == "--set" && has_value) overrides.push_back(args[++i]);
-      else {
-        std::fputs(kUsage, stderr);
-        return 2;
-      }
-    } catch (const std::exception&) {
-      std::fprintf(stderr, "arpipe record: %s needs a number, got '%s'\n%s", a.c_str(), args[i].c_str(), kUsage);
-      return 2;
-    }
-  }
-  if (camera.empty() || out.empty() || (frames > 0 && seconds > 0) || frames < 0 || seconds < 0 ||
-      !camera_overrides(camera, overrides)) {
-    std::fputs(kUsage, stderr);
-    return 2;
-  }
+  std::vector<std::string> source_overrides;  // --width, --fps, ...
+  std::vector<std::string> overrides;         // --set
+};
+
+int record(RecordOptions options) {
+  const std::string& camera = options.camera;
+  const std::string& out = options.out;
+  const std::string& config_path = options.config_path;
+  const std::string& model_path = options.model_path;
+  const int64_t frames = options.frames;
+  const double seconds = options.seconds;
+  std::vector<std::string> overrides = options.source_overrides;
+  overrides.insert(overrides.end(), options.overrides.begin(), options.overrides.end());
+  if (!camera_overrides(camera, overrides)) cli::usage_error("--camera: expected /dev/videoN, v4l2:PATH or libcamera:ID");
   if (!model_path.empty()) overrides.push_back("source.camera_model=" + toml_string(model_path));
 
   try {
@@ -131,6 +108,51 @@ int run_record(const Args& args) {
     log::error("{}", e.what());
     return 2;
   }
+}
+
+}  // namespace
+
+void add_record_command(CLI::App& arpipe) {
+  CLI::App* command = arpipe.add_subcommand("record", "record a live camera with its exposure metadata");
+  auto options = std::make_shared<RecordOptions>();
+  command->add_option("--camera", options->camera,
+                      "/dev/videoN, a /dev/v4l/by-id link, v4l2:PATH, or libcamera:ID|INDEX")
+      ->type_name("CAMERA")
+      ->required();
+  command->add_option("--out", options->out, "where the recording goes")->type_name("DIR")->required();
+  CLI::Option* frames = command->add_option("--frames", options->frames, "stop after N frames")
+                            ->check(CLI::NonNegativeNumber)
+                            ->default_str("until stopped");
+  CLI::Option* seconds = command->add_option("--seconds", options->seconds, "stop after S seconds")
+                             ->type_name("S")
+                             ->check(CLI::NonNegativeNumber)
+                             ->default_str("until stopped");
+  frames->excludes(seconds);
+  command->add_option("--config", options->config_path, "the config whose [source] section to start from")
+      ->type_name("FILE");
+  command->add_option("--camera-model", options->model_path, "the camera's calibration (default: a nominal pinhole)")
+      ->type_name("FILE");
+  // The camera settings become overrides of [source], in this order; --set comes after them.
+  const auto source_key = [command, options](const char* option, const char* key, const char* help, bool quoted) {
+    return command->add_option_function<std::string>(
+        option,
+        [options, key, quoted](const std::string& value) {
+          options->source_overrides.push_back(fmt::format("source.{}={}", key, quoted ? toml_string(value) : value));
+        },
+        help);
+  };
+  source_key("--width", "width", "frame width", false)->type_name("W")->check(CLI::PositiveNumber);
+  source_key("--height", "height", "frame height", false)->type_name("H")->check(CLI::PositiveNumber);
+  source_key("--fps", "fps", "frame rate", false)->type_name("F")->check(CLI::PositiveNumber);
+  source_key("--format", "pixel_format", "YUYV, NV12, RGB24, GREY or MJPG", true)->type_name("F");
+  source_key("--exposure-us", "exposure_us", "a fixed exposure in microseconds", false)
+      ->type_name("US")
+      ->check(CLI::PositiveNumber);
+  source_key("--gain", "gain", "a fixed analogue gain", false)->type_name("G")->check(CLI::PositiveNumber);
+  command->add_option("--set", options->overrides, "override one config key (VALUE in TOML syntax); repeatable")
+      ->type_name("KEY=VALUE")
+      ->allow_extra_args(false);
+  cli::on_run(command, [options] { return record(*options); });
 }
 
 }  // namespace arpipe

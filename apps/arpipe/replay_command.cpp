@@ -3,37 +3,28 @@
 
 #include <cstdio>
 #include <exception>
+#include <memory>
+#include <string>
+#include <vector>
 
 #include "apps/arpipe/commands.h"
+#include "apps/cli/command_line.h"
 #include "apps/common/pipeline_assembly.h"
 #include "core/log.h"
 
 namespace arpipe {
 
 namespace {
-constexpr const char* kUsage = "usage: arpipe replay DIR [--config FILE] [--set KEY=VALUE]...\n";
-}  // namespace
 
-int run_replay(const Args& args) {
+struct ReplayOptions {
   std::string dir, config_path;
   std::vector<std::string> overrides;
-  for (size_t i = 0; i < args.size(); ++i) {
-    const bool has_value = i + 1 < args.size();
-    if (args[i] == "--config" && has_value) {
-      config_path = args[++i];
-    } else if (args[i] == "--set" && has_value) {
-      overrides.push_back(args[++i]);
-    } else if (dir.empty() && !args[i].starts_with("-")) {
-      dir = args[i];
-    } else {
-      std::fputs(kUsage, stderr);
-      return 2;
-    }
-  }
-  if (dir.empty()) {
-    std::fputs(kUsage, stderr);
-    return 2;
-  }
+};
+
+int replay(ReplayOptions options) {
+  const std::string& dir = options.dir;
+  const std::string& config_path = options.config_path;
+  std::vector<std::string>& overrides = options.overrides;
   // The recording and "as fast as possible" come last, so they win over the file.
   overrides.push_back("source.type=\"replay\"");
   overrides.push_back("source.pacing=\"fast\"");
@@ -50,6 +41,20 @@ int run_replay(const Args& args) {
     log::error("{}", e.what());
     return 2;
   }
+}
+
+}  // namespace
+
+void add_replay_command(CLI::App& arpipe) {
+  CLI::App* command = arpipe.add_subcommand("replay", "run the pipeline on a recording as fast as possible");
+  auto options = std::make_shared<ReplayOptions>();
+  command->add_option("DIR", options->dir, "the recording")->required();
+  command->add_option("--config", options->config_path, "the config (default: every key at its default)")
+      ->type_name("FILE");
+  command->add_option("--set", options->overrides, "override one config key (VALUE in TOML syntax); repeatable")
+      ->type_name("KEY=VALUE")
+      ->allow_extra_args(false);
+  cli::on_run(command, [options] { return replay(*options); });
 }
 
 }  // namespace arpipe

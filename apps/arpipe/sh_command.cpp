@@ -5,11 +5,14 @@
 #include <charconv>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include "apps/arpipe/commands.h"
-#include "apps/arpipe/parse_number.h"
+#include "apps/cli/command_line.h"
 #include "core/image/hdr_file.h"
 #include "core/image/openexr_file.h"
 #include "core/image/radiance_hdr.h"
@@ -28,23 +31,12 @@
 namespace arpipe {
 namespace {
 
-constexpr const char* kUsage =
-    "usage: arpipe sh --probe FILE --layout angular|mirror-ball|equirect|cube-cross [--bands N]\n"
-    "                 [--normal X,Y,Z]... [--yaw DEG] [--scale S] [--window none|hanning|lanczos]\n"
-    "                 [--method texels|stratified] [--samples N] [--reconstruct OUT.hdr|.exr|.png]\n"
-    "  Projects a Radiance .hdr or OpenEXR light probe onto real spherical harmonics (Green's order,\n"
-    "  index l(l+1)+m, no Condon-Shortley phase) and prints the radiance coefficients per channel.\n"
-    "  Directions are in arpipe's world frame: the probe's up is +z, its forward +y, turned by --yaw\n"
-    "  degrees about +z. --bands: 1..16 (default 3). --normal (repeatable): prints the irradiance E(n)\n"
-    "  of the band-limited light (Ramamoorthi-Hanrahan: band l times A_l) at that world normal.\n"
-    "  --method: texels (default: every texel times its exact solid angle) or stratified (seed 002's\n"
-    "  N x N jittered sphere samples, --samples N per axis, default 200). --reconstruct writes the\n"
-    "  band-limited probe in the same layout and size: .hdr/.exr as linear radiance, .png tone-mapped\n"
-    "  with Reinhard's global operator (key 0.72) and sRGB-encoded.\n";
-
-int usage_error(const std::string& message) {
-  fmt::print(stderr, "arpipe sh: {}\n{}", message, kUsage);
-  return 2;
+// A number, the whole text (std::from_chars: no locale, no trailing characters).
+std::optional<double> parse_number(std::string_view text) {
+  double v = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (ec != std::errc() || end != text.data() + text.size() || !std::isfinite(v)) return std::nullopt;
+  return v;
 }
 
 std::optional<Vec3> parse_direction(const std::string& text) {
@@ -53,7 +45,8 @@ std::optional<Vec3> parse_direction(const std::string& text) {
   for (size_t axis = 0; axis < 3; ++axis) {
     const size_t comma = text.find(',', start);
     if ((axis < 2) != (comma != std::string::npos)) return std::nullopt;
-    const std::optional<double> value = parse_number(text.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+    const std::optional<double> value =
+        parse_number(std::string_view(text).substr(start, comma == std::string::npos ? std::string::npos : comma - start));
     if (!value) return std::nullopt;
     v[axis] = *value;
     start = comma + 1;
@@ -95,67 +88,29 @@ void write_png(const std::string& path, HdrImage image) {
   if (!cv::imwrite(path, bgr)) throw std::runtime_error(fmt::format("{}: could not write the PNG", path));
 }
 
-}  // namespace
-
-int run_sh(const Args& args) {
+struct ShOptions {
   std::string probe_file, layout_name, window_name = "none", method = "texels", reconstruct_path;
   int bands = 3, samples = 200;
   double yaw_deg = 0, scale = 1;
-  std::vector<Vec3> normals;
-  for (size_t i = 0; i < args.size(); ++i) {
-    const std::string& arg = args[i];
-    if (arg == "--help" || arg == "-h") {
-      fmt::print("{}", kUsage);
-      return 0;
-    }
-    if (i + 1 >= args.size()) return usage_error(fmt::format("{} needs a value", arg));
-    const std::string& value = args[++i];
-    if (arg == "--probe") {
-      probe_file = value;
-    } else if (arg == "--layout") {
-      layout_name = value;
-    } else if (arg == "--window") {
-      window_name = value;
-    } else if (arg == "--method") {
-      method = value;
-    } else if (arg == "--reconstruct") {
-      reconstruct_path = value;
-    } else if (arg == "--normal") {
-      const std::optional<Vec3> n = parse_direction(value);
-      if (!n) return usage_error(fmt::format("--normal: expected X,Y,Z (not all zero), got \"{}\"", value));
-      normals.push_back(*n);
-    } else if (arg == "--bands" || arg == "--samples" || arg == "--yaw" || arg == "--scale") {
-      const std::optional<double> number = parse_number(value);
-      if (!number) return usage_error(fmt::format("{}: expected a number, got \"{}\"", arg, value));
-      if (arg == "--bands") {
-        if (*number != std::floor(*number) || *number < 1 || *number > kMaxShBands)
-          return usage_error(fmt::format("--bands: expected an integer in [1, {}], got {}", kMaxShBands, value));
-        bands = int(*number);
-      } else if (arg == "--samples") {
-        if (*number != std::floor(*number) || *number < 1 || *number > 400)
-          return usage_error(fmt::format("--samples: expected an integer in [1, 400], got {}", value));
-        samples = int(*number);
-      } else if (arg == "--yaw") {
-        yaw_deg = *number;
-      } else {
-        if (*number <= 0) return usage_error(fmt::format("--scale: expected a number > 0, got {}", value));
-        scale = *number;
-      }
-    } else {
-      return usage_error(fmt::format("unknown option \"{}\"", arg));
-    }
-  }
-  if (probe_file.empty()) return usage_error("--probe FILE is required");
-  if (layout_name.empty()) return usage_error("--layout is required");
-  const std::optional<EnvironmentLayout> layout = parse_environment_layout(layout_name);
-  if (!layout) return usage_error(fmt::format("--layout: expected angular, mirror-ball, equirect or cube-cross, got \"{}\"", layout_name));
+  std::vector<std::string> normals;
+};
+
+bool is_image_file(const std::string& path) {
+  return ends_with(path, ".hdr") || ends_with(path, ".exr") || ends_with(path, ".png");
+}
+
+// The options are checked when read (add_sh_command): what is parsed here is known to parse.
+int run_sh(const ShOptions& options) {
+  const std::string& probe_file = options.probe_file;
+  const std::string& window_name = options.window_name;
+  const std::string& method = options.method;
+  const std::string& reconstruct_path = options.reconstruct_path;
+  const int bands = options.bands, samples = options.samples;
+  const double yaw_deg = options.yaw_deg, scale = options.scale;
+  const std::optional<EnvironmentLayout> layout = parse_environment_layout(options.layout_name);
   const std::optional<ShWindow> window = parse_sh_window(window_name);
-  if (!window) return usage_error(fmt::format("--window: expected none, hanning or lanczos, got \"{}\"", window_name));
-  if (method != "texels" && method != "stratified")
-    return usage_error(fmt::format("--method: expected texels or stratified, got \"{}\"", method));
-  if (!reconstruct_path.empty() && !ends_with(reconstruct_path, ".hdr") && !ends_with(reconstruct_path, ".exr") &&
-      !ends_with(reconstruct_path, ".png"))
-    return usage_error("--reconstruct: the file must end in .hdr, .exr or .png");
+  std::vector<Vec3> normals;
+  for (const std::string& text : options.normals) normals.push_back(*parse_direction(text));
 
   const Mat3 R_world_probe = default_world_from_probe(yaw_deg * std::numbers::pi / 180);
   try {
@@ -211,6 +166,48 @@ int run_sh(const Args& args) {
     return 1;
   }
   return 0;
+}
+
+}  // namespace
+
+void add_sh_command(CLI::App& arpipe) {
+  CLI::App* command =
+      arpipe.add_subcommand("sh", "an HDR light probe's spherical-harmonic coefficients and irradiance");
+  command->footer(
+      "Projects a Radiance .hdr or OpenEXR light probe onto real spherical harmonics (Green's order, index\n"
+      "l(l+1)+m, no Condon-Shortley phase) and prints the radiance coefficients per channel. Directions are in\n"
+      "arpipe's world frame: the probe's up is +z, its forward +y, turned by --yaw degrees about +z. --normal\n"
+      "prints the irradiance E(n) of the band-limited light (Ramamoorthi-Hanrahan: band l times A_l) at that\n"
+      "world normal. --reconstruct writes the band-limited probe in the same layout and size: .hdr/.exr as\n"
+      "linear radiance, .png tone-mapped with Reinhard's global operator (key 0.72) and sRGB-encoded.");
+  auto options = std::make_shared<ShOptions>();
+  command->add_option("--probe", options->probe_file, "the HDR light probe (.hdr, .exr)")->type_name("FILE")->required();
+  command->add_option("--layout", options->layout_name, "angular, mirror-ball, equirect or cube-cross")
+      ->type_name("L")
+      ->required()
+      ->check(cli::accepted_by([](const std::string& t) { return parse_environment_layout(t).has_value(); },
+                               "angular, mirror-ball, equirect or cube-cross"));
+  command->add_option("--bands", options->bands, "SH bands")->check(CLI::Range(1, kMaxShBands));
+  command->add_option("--normal", options->normals, "print the irradiance at this world normal; repeatable")
+      ->type_name("X,Y,Z")
+      ->allow_extra_args(false)
+      ->check(cli::accepted_by([](const std::string& t) { return parse_direction(t).has_value(); },
+                               "X,Y,Z (not all zero)"));
+  command->add_option("--yaw", options->yaw_deg, "the probe's turn about +z")->type_name("DEG");
+  command->add_option("--scale", options->scale, "radiance scale")->type_name("S")->check(CLI::PositiveNumber);
+  command->add_option("--window", options->window_name, "ringing window: none, hanning or lanczos")
+      ->check(cli::accepted_by([](const std::string& t) { return parse_sh_window(t).has_value(); },
+                               "none, hanning or lanczos"));
+  command->add_option("--method", options->method,
+                      "texels (every texel times its exact solid angle) or stratified (seed 002's N x N jittered "
+                      "sphere samples, --samples N per axis)")
+      ->check(CLI::IsMember({"texels", "stratified"}));
+  command->add_option("--samples", options->samples, "sphere samples per axis for --method stratified")
+      ->check(CLI::Range(1, 400));
+  command->add_option("--reconstruct", options->reconstruct_path, "write the band-limited probe")
+      ->type_name("OUT.hdr|.exr|.png")
+      ->check(cli::accepted_by(is_image_file, "a file ending in .hdr, .exr or .png"));
+  cli::on_run(command, [options] { return run_sh(*options); });
 }
 
 }  // namespace arpipe

@@ -1,14 +1,15 @@
 // arpipe simulate: renders a simulator scene (configs/sim/*.toml) into a recording with ground truth.
 #include <fmt/format.h>
 
-#include <charconv>
 #include <cstdio>
 #include <exception>
+#include <memory>
 #include <new>
 #include <stdexcept>
 
 #include "apps/arpipe/commands.h"
-#include "apps/arpipe/progress_bar.h"
+#include "apps/cli/command_line.h"
+#include "apps/cli/progress_bar.h"
 #include "capture/sim/sim_scene_loader.h"
 #include "capture/sim/simulator.h"
 #include "core/log.h"
@@ -16,57 +17,17 @@
 namespace arpipe {
 
 namespace {
-constexpr const char* kUsage =
-    "usage: arpipe simulate --scene FILE --out DIR [--frames N] [--seed S] [--threads N] [--samples N]\n"
-    "  Renders the scene (docs/SIMULATOR.md) into a recording at DIR (which must not hold one),\n"
-    "  with ground truth, and DIR/ground_truth_composite when the scene has virtual objects.\n"
-    "  --samples overrides the scene's render.samples_per_pixel (a square number).\n";
 
-template <typename T>
-bool parse_number(const std::string& text, T& out) {
-  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), out);
-  return ec == std::errc() && end == text.data() + text.size();
-}
-}  // namespace
-
-int run_simulate(const Args& args) {
+struct SimulateOptions {
   std::string scene_path;
-  sim::SimulateOptions options;
-  int samples = 0;
-  for (size_t i = 0; i < args.size(); ++i) {
-    if (args[i] == "--help" || args[i] == "-h") {
-      std::fputs(kUsage, stdout);
-      return 0;
-    }
-    if (i + 1 >= args.size()) {
-      fmt::print(stderr, "arpipe simulate: {} needs a value\n{}", args[i], kUsage);
-      return 2;
-    }
-    const std::string& key = args[i];
-    const std::string& value = args[++i];
-    bool ok = true;
-    if (key == "--scene") scene_path = value;
-    else if (key == "--out") options.out_dir = value;
-    else if (key == "--frames") ok = parse_number(value, options.frames) && options.frames > 0;
-    else if (key == "--seed") {
-      uint64_t seed = 0;
-      ok = parse_number(value, seed);
-      options.seed = seed;
-    } else if (key == "--threads") ok = parse_number(value, options.threads) && options.threads > 0;
-    else if (key == "--samples") ok = parse_number(value, samples) && sim::samples_per_axis(samples) > 0;
-    else {
-      fmt::print(stderr, "arpipe simulate: unknown option {}\n{}", key, kUsage);
-      return 2;
-    }
-    if (!ok) {
-      fmt::print(stderr, "arpipe simulate: bad value '{}' for {}\n{}", value, key, kUsage);
-      return 2;
-    }
-  }
-  if (scene_path.empty() || options.out_dir.empty()) {
-    fmt::print(stderr, "arpipe simulate: --scene and --out are required\n{}", kUsage);
-    return 2;
-  }
+  sim::SimulateOptions simulate;
+  int samples = 0;  // 0: the scene's render.samples_per_pixel
+};
+
+int run_simulate(SimulateOptions& command) {
+  const std::string& scene_path = command.scene_path;
+  sim::SimulateOptions& options = command.simulate;
+  const int samples = command.samples;
   sim::SimScene scene;
   try {
     scene = sim::load_sim_scene(scene_path);
@@ -100,6 +61,35 @@ int run_simulate(const Args& args) {
     log::error("{}", e.what());
     return 1;
   }
+}
+
+}  // namespace
+
+void add_simulate_command(CLI::App& arpipe) {
+  CLI::App* command = arpipe.add_subcommand(
+      "simulate", "render a simulator scene (configs/sim/, docs/SIMULATOR.md) into a recording with exact ground truth");
+  command->footer("DIR must not hold a recording; DIR/ground_truth_composite is written when the scene has virtual objects.");
+  auto options = std::make_shared<SimulateOptions>();
+  command->add_option("--scene", options->scene_path, "the simulator scene")->type_name("FILE")->required();
+  command->add_option("--out", options->simulate.out_dir, "where the recording goes")->type_name("DIR")->required();
+  command->add_option("--frames", options->simulate.frames, "render only the first N frames")
+      ->check(CLI::PositiveNumber)
+      ->default_str("all");
+  command->add_option_function<uint64_t>(
+             "--seed", [options](const uint64_t& seed) { options->simulate.seed = seed; }, "the noise's random seed")
+      ->default_str("the scene's render.seed");
+  command->add_option("--threads", options->simulate.threads, "render threads")
+      ->check(CLI::PositiveNumber)
+      ->default_str("every core");
+  command->add_option("--samples", options->samples, "override the scene's render.samples_per_pixel (a square number)")
+      ->check(cli::accepted_by([](const std::string& text) {
+        try {
+          return sim::samples_per_axis(std::stoi(text)) > 0;
+        } catch (const std::exception&) {
+          return false;
+        }
+      }, "a square number"));
+  cli::on_run(command, [options] { return run_simulate(*options); });
 }
 
 }  // namespace arpipe

@@ -2,16 +2,15 @@
 // elevation, an East-North-Up vector and, given the anchor's heading, a vector in the anchor frame.
 #include <fmt/format.h>
 
-#include <charconv>
 #include <cmath>
 #include <cstdio>
-#include <map>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
 
 #include "apps/arpipe/commands.h"
-#include "apps/arpipe/parse_number.h"
+#include "apps/cli/command_line.h"
 #include "core/sun/civil_time.h"
 #include "core/sun/delta_t.h"
 #include "core/sun/sun_direction.h"
@@ -21,21 +20,6 @@
 namespace arpipe {
 
 namespace {
-
-constexpr const char* kUsage =
-    "usage: arpipe sun --lat DEG --lon DEG --time ISO8601 [--alt M] [--delta-t S] [--pressure MBAR]\n"
-    "                  [--temperature C] [--heading DEG] [--declination DEG] [--algorithm spa|psa|both]\n"
-    "  Where the sun is, seen from latitude/longitude (degrees, north and east positive) at altitude M\n"
-    "  (metres, default 0), at the time given in ISO 8601 (2026-06-21T10:30:00Z, ...+02:00; no zone = UTC).\n"
-    "  --delta-t: TT - UT in seconds (default: Espenak-Meeus estimate); --pressure (default 1013.25 mbar)\n"
-    "  and --temperature (default 15 C) set the refraction. --heading: bearing of the anchor's +y axis\n"
-    "  (the tag's top edge) from true north, clockwise; --declination (degrees east) is added when the\n"
-    "  heading was read off a compass. --algorithm: spa (default, NREL SPA), psa (seed 001's PSA) or both.\n";
-
-int usage_error(const std::string& message) {
-  fmt::print(stderr, "arpipe sun: {}\n{}", message, kUsage);
-  return 2;
-}
 
 void print_direction(const char* label, const Vec3& v) {
   fmt::print("  {:<28} [{:+.6f}, {:+.6f}, {:+.6f}]\n", label, v[0], v[1], v[2]);
@@ -63,64 +47,31 @@ void print_sun(const char* name, double azimuth, double zenith_apparent, double 
     fmt::print("  only the upper limb is above the horizon: direct light, no shadows cast\n");
 }
 
-}  // namespace
+struct SunOptions {
+  std::string time, algorithm = "spa";
+  SpaInput in;  // all but the time
+  std::optional<double> delta_t_s, heading_deg;
+  double declination_deg = 0;
+};
 
-int run_sun(const Args& args) {
-  std::map<std::string, std::string> values;
-  static const char* const kOptions[] = {"--lat",      "--lon",     "--alt",         "--time",
-                                         "--delta-t",  "--pressure", "--temperature", "--heading",
-                                         "--declination", "--algorithm"};
-  for (size_t i = 0; i < args.size(); ++i) {
-    if (args[i] == "--help" || args[i] == "-h") {
-      std::fputs(kUsage, stdout);
-      return 0;
-    }
-    bool known = false;
-    for (const char* o : kOptions) known = known || args[i] == o;
-    if (!known) return usage_error(fmt::format("unexpected argument '{}'", args[i]));
-    if (i + 1 >= args.size()) return usage_error(fmt::format("{} needs a value", args[i]));
-    if (values.count(args[i]) != 0) return usage_error(fmt::format("{} given twice", args[i]));
-    values[args[i]] = args[i + 1];
-    ++i;
-  }
-  for (const char* required : {"--lat", "--lon", "--time"})
-    if (values.count(required) == 0) return usage_error(fmt::format("{} is required", required));
-
-  std::map<std::string, double> numbers;
-  for (const auto& [key, text] : values) {
-    if (key == "--time" || key == "--algorithm") continue;
-    const std::optional<double> v = parse_number(text);
-    if (!v) return usage_error(fmt::format("bad value '{}' for {}: expected a number", text, key));
-    numbers[key] = *v;
-  }
-  const std::string algorithm = values.count("--algorithm") ? values["--algorithm"] : "spa";
-  if (algorithm != "spa" && algorithm != "psa" && algorithm != "both")
-    return usage_error(fmt::format("bad value '{}' for --algorithm: expected spa, psa or both", algorithm));
-
-  SpaInput in;
+int run_sun(SunOptions options) {
+  SpaInput& in = options.in;
   try {
-    in.time = UtcInstant::parse(values["--time"]);
+    in.time = UtcInstant::parse(options.time);
   } catch (const std::invalid_argument& e) {
-    return usage_error(fmt::format("--time: {}", e.what()));
+    cli::usage_error(fmt::format("--time: {}", e.what()));
   }
-  in.latitude_deg = numbers["--lat"];
-  in.longitude_deg = numbers["--lon"];
-  if (numbers.count("--alt")) in.elevation_m = numbers["--alt"];
-  if (numbers.count("--pressure")) in.pressure_mbar = numbers["--pressure"];
-  if (numbers.count("--temperature")) in.temperature_c = numbers["--temperature"];
-  const bool delta_t_given = numbers.count("--delta-t") != 0;
-  in.delta_t_s = delta_t_given ? numbers["--delta-t"] : delta_t_estimate_s(in.time.decimal_year());
+  const bool delta_t_given = options.delta_t_s.has_value();
+  in.delta_t_s = delta_t_given ? *options.delta_t_s : delta_t_estimate_s(in.time.decimal_year());
   std::optional<AnchorHeading> heading;
-  if (numbers.count("--heading"))
-    heading = AnchorHeading{numbers["--heading"], numbers.count("--declination") ? numbers["--declination"] : 0.0};
-  else if (numbers.count("--declination"))
-    return usage_error("--declination needs --heading (the compass reading it corrects)");
+  if (options.heading_deg) heading = AnchorHeading{*options.heading_deg, options.declination_deg};
+  const std::string& algorithm = options.algorithm;
 
   // The config boundary: SPA's checks name the value and its range (latitude 95 -> exit 2).
   try {
     validate_spa_input(in);
   } catch (const std::invalid_argument& e) {
-    return usage_error(e.what());
+    cli::usage_error(e.what());
   }
 
   fmt::print("time (UTC)                     {}\n", in.time.iso8601());
@@ -142,6 +93,47 @@ int run_sun(const Args& args) {
     print_sun("PSA (seed 001; no refraction, ~0.01 deg)", p.azimuth_deg, p.zenith_deg, p.zenith_deg, heading, false);
   }
   return 0;
+}
+
+}  // namespace
+
+void add_sun_command(CLI::App& arpipe) {
+  CLI::App* command = arpipe.add_subcommand(
+      "sun", "the sun's azimuth, elevation and direction (ENU, anchor frame) for a place and time (NREL SPA and/or PSA)");
+  auto options = std::make_shared<SunOptions>();
+  SpaInput& in = options->in;
+  command->add_option("--lat", in.latitude_deg, "latitude, north positive")->type_name("DEG")
+      ->check(cli::finite_number())->required();
+  command->add_option("--lon", in.longitude_deg, "longitude, east positive")->type_name("DEG")
+      ->check(cli::finite_number())->required();
+  command->add_option("--time", options->time, "ISO 8601: 2026-06-21T10:30:00Z, ...+02:00; no zone = UTC")
+      ->type_name("ISO8601")
+      ->required();
+  command->add_option("--alt", in.elevation_m, "altitude in metres")->type_name("M")
+      ->check(cli::finite_number());
+  command->add_option_function<double>("--delta-t", [options](const double& s) { options->delta_t_s = s; },
+                                       "TT - UT in seconds")
+      ->type_name("S")
+      ->check(cli::finite_number())
+      ->default_str("the Espenak-Meeus estimate");
+  command->add_option("--pressure", in.pressure_mbar, "air pressure, for the refraction")->type_name("MBAR")
+      ->check(cli::finite_number());
+  command->add_option("--temperature", in.temperature_c, "air temperature, for the refraction")->type_name("C")
+      ->check(cli::finite_number());
+  CLI::Option* heading =
+      command->add_option_function<double>("--heading", [options](const double& deg) { options->heading_deg = deg; },
+                                           "bearing of the anchor's +y axis (the tag's top edge) from true north, "
+                                           "clockwise")
+          ->type_name("DEG")
+      ->check(cli::finite_number());
+  command->add_option("--declination", options->declination_deg,
+                      "degrees east, added when the heading was read off a compass")
+      ->type_name("DEG")
+      ->check(cli::finite_number())
+      ->needs(heading);
+  command->add_option("--algorithm", options->algorithm, "spa (NREL SPA), psa (seed 001's PSA) or both")
+      ->check(CLI::IsMember({"spa", "psa", "both"}));
+  cli::on_run(command, [options] { return run_sun(*options); });
 }
 
 }  // namespace arpipe

@@ -34,6 +34,11 @@ class ArpipeCli : public ::testing::Test {
     if (status == -1 || !WIFEXITED(status)) return -1;  // a timeout or a crash
     return WEXITSTATUS(status);
   }
+  // A build with -DARPIPE_BUILD_BENCH=OFF (CI's sanitizer tree) has no benchmarks to run.
+  bool benchmarks_built() {
+    std::string out;
+    return run({"bench", "--help"}, &out) == 0 && out.find("blur") != std::string::npos;
+  }
   fs::path dir_;
 };
 
@@ -131,6 +136,7 @@ TEST_F(ArpipeCli, ReplayRefusesAFallbackExposureLongerThanTheFrameInterval) {
 }
 
 TEST_F(ArpipeCli, BenchBlurPrintsItsTableOnAShortCapture) {
+  if (!benchmarks_built()) GTEST_SKIP() << "arpipe built without the benchmarks";
   // A 6-frame blur-bench capture at 1 sample per pixel and a 16-render reference: the command runs
   // end to end and prints a row per method; the numbers themselves are the bench's, not a test's.
   const fs::path capture = dir_ / "capture";
@@ -183,6 +189,65 @@ TEST_F(ArpipeCli, UnknownCommandIsAUsageError) {
   std::string err;
   EXPECT_EQ(run({"frobnicate"}, nullptr, &err), 2);
   EXPECT_NE(err.find("frobnicate"), std::string::npos) << err;
+  EXPECT_EQ(run({}, nullptr, &err), 2);  // no command at all
+}
+
+TEST_F(ArpipeCli, VersionAndHelpOfEveryCommand) {
+  std::string out, err;
+  ASSERT_EQ(run({"--version"}, &out, &err), 0) << err;
+  EXPECT_EQ(out.rfind("arpipe 0.", 0), 0u) << out;  // the CMake project version, then git describe
+  ASSERT_EQ(run({"--help"}, &out, &err), 0) << err;
+  const std::vector<std::string> commands{"inspect", "replay", "simulate", "calib", "board", "bench",
+                                          "sh",      "bake",   "sun",      "cameras", "record", "config"};
+  for (const std::string& command : commands) {
+    EXPECT_NE(out.find("  " + command + " "), std::string::npos) << command << "\n" << out;
+    std::string help;
+    EXPECT_EQ(run({command, "--help"}, &help, &err), 0) << command << ": " << err;
+    EXPECT_NE(help.find("Usage: arpipe " + command), std::string::npos) << help;
+  }
+  if (!benchmarks_built()) return;
+  for (const char* bench : {"pipeline", "pose", "sim-render", "blur", "shadows", "probe", "sun", "capture-path",
+                            "calib-corners", "calib-solve", "sh", "prt"}) {
+    std::string help;
+    EXPECT_EQ(run({"bench", bench, "--help"}, &help, &err), 0) << bench << ": " << err;
+    EXPECT_NE(help.find(std::string("Usage: arpipe bench ") + bench), std::string::npos) << help;
+  }
+}
+
+TEST_F(ArpipeCli, UsageErrorsExitTwoNamingTheOption) {
+  std::string err;
+  EXPECT_EQ(run({"bake", "builtin:cup", "--bands", "0"}, nullptr, &err), 2);
+  EXPECT_NE(err.find("arpipe bake: --bands"), std::string::npos) << err;
+  EXPECT_EQ(run({"simulate", "--scene", "x.toml"}, nullptr, &err), 2);
+  EXPECT_NE(err.find("--out"), std::string::npos) << err;
+  EXPECT_EQ(run({"replay", kCapture.string(), "--frobnicate"}, nullptr, &err), 2);
+  EXPECT_NE(err.find("--frobnicate"), std::string::npos) << err;
+  EXPECT_EQ(run({"sun", "--lat", "52", "--lon", "13", "--time", "2026-06-21T10:30:00Z", "--declination", "3"}, nullptr,
+                &err),
+            2);
+  EXPECT_NE(err.find("--declination"), std::string::npos) << err;
+  EXPECT_EQ(run({"bench", "sun", "--calls", "zero"}, nullptr, &err), 2);
+  EXPECT_NE(err.find("--calls"), std::string::npos) << err;
+}
+
+TEST_F(ArpipeCli, BenchSunPrintsItsTable) {
+  if (!benchmarks_built()) GTEST_SKIP() << "arpipe built without the benchmarks";
+  std::string out, err;
+  ASSERT_EQ(run({"bench", "sun", "--calls", "200", "--repeats", "3"}, &out, &err), 0) << err;
+  EXPECT_NE(out.find("| NREL SPA (topocentric, refraction) |"), std::string::npos) << out;
+  EXPECT_NE(out.find("| PSA (seed 001) |"), std::string::npos) << out;
+}
+
+TEST_F(ArpipeCli, DaemonPrintsItsVersionAndHelp) {
+  std::string out, err;
+  const int version = test::run_to_exit(test::build_program("arpiped"), {"--version"}, dir_ / "logs", &err);
+  EXPECT_EQ(version, 0) << err;
+  test::ChildProcess help(test::build_program("arpiped"), {"--help"}, dir_ / "logs");
+  ASSERT_EQ(help.wait(), 0);
+  EXPECT_NE(help.stdout_text().find("--config FILE"), std::string::npos) << help.stdout_text();
+  EXPECT_NE(help.stdout_text().find("--set KEY=VALUE"), std::string::npos) << help.stdout_text();
+  EXPECT_EQ(test::run_to_exit(test::build_program("arpiped"), {"--frobnicate"}, dir_ / "logs", &err), 2);
+  EXPECT_NE(err.find("--frobnicate"), std::string::npos) << err;
 }
 
 // The numbers after "]: [" on the first line containing `label`.

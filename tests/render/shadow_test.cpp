@@ -1,12 +1,12 @@
 // Virtual shadows on the real ground against the simulator's ray-traced truth
-// (apps/bench/shadow_comparison.h): the virtual balls of probe-indoor (a lamp) and sun-outdoor.
+// (bench/shadow_comparison.h): the virtual balls of probe-indoor (a lamp) and sun-outdoor.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <string>
 #include <vector>
 
-#include "apps/bench/shadow_comparison.h"
+#include "bench/shadow_comparison.h"
 #include "capture/sim/sim_scene_loader.h"
 #include "render_test_support.h"
 

@@ -1,5 +1,5 @@
 // PRT against Lambert shading at run time (see prt_runtime_cost.h).
-#include "apps/arpipe/prt_runtime_cost.h"
+#include "bench/prt_runtime_cost.h"
 
 #include <fmt/format.h>
 

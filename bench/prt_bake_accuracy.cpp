@@ -8,13 +8,15 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <memory>
 #include <numbers>
 #include <sstream>
 #include <string>
 #include <vector>
 
-#include "apps/arpipe/commands.h"
-#include "apps/arpipe/prt_runtime_cost.h"
+#include "apps/cli/command_line.h"
+#include "bench/benchmarks.h"
+#include "bench/prt_runtime_cost.h"
 #include "core/sh/sh_basis.h"
 #include "render/prt/prt_bake.h"
 #include "render/prt/prt_test_meshes.h"
@@ -22,23 +24,8 @@
 namespace arpipe {
 namespace {
 
-constexpr const char* kUsage =
-    "usage: arpipe bench prt [--samples N,N,...] [--reference N] [--subdivisions N] [--threads N]\n"
-    "  Bakes an open box (1 m floor, 0.5 m walls, open at the top) with every transfer kind at each\n"
-    "  sample count and prints the bake time, rays per second, and the RMS and max error of the\n"
-    "  transfer vectors and of the radiance they shade under a fixed lighting (Grace Cathedral's\n"
-    "  9 coefficients), relative to the reference's RMS. Times are the fastest of 3 runs and include\n"
-    "  building Embree's BVH.\n"
-    "  --samples LIST    samples per axis (default 4,8,16,32,64)\n"
-    "  --reference N     samples per axis of the shadowed and interreflected reference (default 256);\n"
-    "                    the unshadowed reference is the closed form A_l / pi y_i(n)\n"
-    "  --subdivisions N  grid per face of the box (default 8: 405 vertices)\n"
-    "  --threads N       bake threads (default: every core)\n"
-    "  --frames N        then the run-time cost: the render stage with PRT against per-pixel Lambert\n"
-    "                    + SH irradiance on the same meshes, N frames each (default 40; 0: skip)\n";
-
 // The test lighting, radiance SH in the object frame (z up), 3 bands: Ramamoorthi and Hanrahan's
-// Grace Cathedral coefficients (docs: reference/rendering.md section 3), same basis convention.
+// Grace Cathedral coefficients (docs/reference/rendering.md section 3), same basis convention.
 constexpr std::array<std::array<double, 3>, 9> kLighting{{{0.79, 0.44, 0.54},
                                                           {0.39, 0.35, 0.60},
                                                           {-0.34, -0.18, -0.27},
@@ -99,49 +86,15 @@ std::vector<double> analytic_unshadowed(const Mesh& mesh) {
   return out;
 }
 
-}  // namespace
-
-int run_bench_prt(const Args& args) {
+struct PrtOptions {
   std::vector<int> sample_counts{4, 8, 16, 32, 64};
   int reference_samples = 256, subdivisions = 8, threads = 0, runtime_frames = 40;
-  try {
-    for (size_t i = 0; i < args.size(); ++i) {
-      const auto value = [&]() -> const std::string& {
-        if (i + 1 >= args.size()) throw std::invalid_argument(fmt::format("{} needs a value", args[i]));
-        return args[++i];
-      };
-      if (args[i] == "--samples") {
-        sample_counts.clear();
-        std::stringstream list(value());
-        for (std::string item; std::getline(list, item, ',');) sample_counts.push_back(std::stoi(item));
-      } else if (args[i] == "--reference") {
-        reference_samples = std::stoi(value());
-      } else if (args[i] == "--subdivisions") {
-        subdivisions = std::stoi(value());
-      } else if (args[i] == "--threads") {
-        threads = std::stoi(value());
-      } else if (args[i] == "--frames") {
-        runtime_frames = std::stoi(value());
-      } else if (args[i] == "--help" || args[i] == "-h") {
-        std::fputs(kUsage, stdout);
-        return 0;
-      } else {
-        throw std::invalid_argument(fmt::format("unknown argument \"{}\"", args[i]));
-      }
-    }
-    if (sample_counts.empty() || std::any_of(sample_counts.begin(), sample_counts.end(),
-                                             [](int n) { return n < 1 || n > 4096; }))
-      throw std::invalid_argument("--samples needs counts in [1, 4096]");
-    if (reference_samples < 1 || reference_samples > 4096)
-      throw std::invalid_argument("--reference must be in [1, 4096]");
-    if (subdivisions < 1 || subdivisions > 256) throw std::invalid_argument("--subdivisions must be in [1, 256]");
-    if (threads < 0 || threads > 1024) throw std::invalid_argument("--threads must be in [0, 1024]");
-    if (runtime_frames < 0 || runtime_frames > 10000) throw std::invalid_argument("--frames must be in [0, 10000]");
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "arpipe bench prt: %s\n%s", e.what(), kUsage);
-    return 2;
-  }
+};
 
+int run_prt_benchmark(const PrtOptions& options) {
+  const std::vector<int>& sample_counts = options.sample_counts;
+  const int reference_samples = options.reference_samples, subdivisions = options.subdivisions,
+            threads = options.threads, runtime_frames = options.runtime_frames;
   try {
     const Mesh box = make_open_box(1.0, 0.5, subdivisions);
     std::printf("open box 1 x 1 x 0.5 m, %d x %d per face: %zu vertices, %zu triangles; %d bands\n", subdivisions,
@@ -195,6 +148,36 @@ int run_bench_prt(const Args& args) {
     return 1;
   }
   return 0;
+}
+
+}  // namespace
+
+void add_prt_benchmark(CLI::App& bench) {
+  CLI::App* command = bench.add_subcommand(
+      "prt", "PRT bake: time against samples against the error vs a ray-traced reference; run-time cost vs Lambert");
+  command->footer(
+      "Bakes an open box (1 m floor, 0.5 m walls, open at the top) with every transfer kind at each sample count\n"
+      "and prints the bake time, rays per second, and the RMS and max error of the transfer vectors and of the\n"
+      "radiance they shade under a fixed lighting (Grace Cathedral's 9 coefficients), relative to the\n"
+      "reference's RMS. Times are the fastest of 3 runs and include building Embree's BVH.");
+  auto options = std::make_shared<PrtOptions>();
+  command->add_option("--samples", options->sample_counts, "samples per axis, a comma-separated list")
+      ->type_name("N,N,...")
+      ->delimiter(',')
+      ->allow_extra_args(false)
+      ->check(CLI::Range(1, 4096));
+  command->add_option("--reference", options->reference_samples,
+                      "samples per axis of the shadowed and interreflected reference (the unshadowed reference is "
+                      "the closed form A_l / pi y_i(n))")
+      ->check(CLI::Range(1, 4096));
+  command->add_option("--subdivisions", options->subdivisions, "grid per face of the box (8: 405 vertices)")
+      ->check(CLI::Range(1, 256));
+  command->add_option("--threads", options->threads, "bake threads (0: every core)")->check(CLI::Range(0, 1024));
+  command->add_option("--frames", options->runtime_frames,
+                      "then the run-time cost: the render stage with PRT against per-pixel Lambert + SH irradiance on "
+                      "the same meshes, N frames each (0: skip)")
+      ->check(CLI::Range(0, 10000));
+  cli::on_run(command, [options] { return run_prt_benchmark(*options); });
 }
 
 }  // namespace arpipe

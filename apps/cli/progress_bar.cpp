@@ -1,5 +1,5 @@
 // ProgressBar: drawing.
-#include "apps/arpipe/progress_bar.h"
+#include "apps/cli/progress_bar.h"
 
 #include <fmt/format.h>
 #include <unistd.h>

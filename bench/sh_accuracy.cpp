@@ -9,13 +9,15 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <memory>
 #include <numbers>
 #include <random>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
-#include "apps/arpipe/commands.h"
+#include "apps/cli/command_line.h"
+#include "bench/benchmarks.h"
 #include "core/geometry/vec.h"
 #include "core/sh/sh_basis.h"
 #include "core/sh/sh_irradiance.h"
@@ -27,16 +29,6 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 constexpr int kMaxBands = 7;
-
-constexpr const char* kUsage =
-    "usage: arpipe bench sh [--samples N] [--seed S]\n"
-    "  An analytic environment (sky gradient + coloured wall + small bright sun disk) projected on\n"
-    "  real SH: (1) the radiance's RMS reconstruction error for 1, 3, 5, 7 bands, unwindowed and\n"
-    "  Hanning-windowed, from exact coefficients, the seed's N x N jittered sampler and an N x N\n"
-    "  Gauss-Legendre product rule, with projection times; (2) the irradiance error of 2, 3, 4 bands\n"
-    "  against a Monte Carlo reference (2^16 stratified cosine-weighted samples per normal).\n"
-    "  --samples N  samples per axis of the jittered and product-rule projections (default 200)\n"
-    "  --seed S     jitter seed (default 1)\n";
 
 using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
@@ -211,35 +203,7 @@ ErrorStats relative_errors(const ShRgb& radiance, const std::vector<Vec3>& norma
   return s;
 }
 
-}  // namespace
-
-int run_bench_sh(const std::vector<std::string>& args) {
-  int samples = 200;
-  uint64_t seed = 1;
-  for (size_t i = 0; i < args.size(); ++i) {
-    const auto value = [&]() -> const std::string& {
-      if (i + 1 >= args.size()) throw std::invalid_argument(fmt::format("{} needs a value", args[i]));
-      return args[++i];
-    };
-    try {
-      if (args[i] == "--samples") samples = std::stoi(value());
-      else if (args[i] == "--seed") seed = std::stoull(value());
-      else if (args[i] == "--help" || args[i] == "-h") {
-        std::fputs(kUsage, stdout);
-        return 0;
-      } else {
-        throw std::invalid_argument(fmt::format("unknown argument \"{}\"", args[i]));
-      }
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "arpipe bench sh: %s\n%s", e.what(), kUsage);
-      return 2;
-    }
-  }
-  if (samples < 2 || samples > 2000) {
-    std::fprintf(stderr, "arpipe bench sh: --samples must be in [2, 2000]\n");
-    return 2;
-  }
-
+int run_sh_benchmark(int samples, uint64_t seed) {
   const Environment env;
   fmt::print("Environment (a plain function of direction, scene-linear radiance, RGB; the parts add):\n");
   fmt::print("  sky: ({:.2f}, {:.2f}, {:.2f}) * (0.2 + 0.8 ((1 + z) / 2)^2) over the whole sphere\n", env.sky[0],
@@ -367,6 +331,28 @@ int run_bench_sh(const std::vector<std::string>& args) {
     std::fflush(stdout);
   }
   return 0;
+}
+
+}  // namespace
+
+void add_sh_benchmark(CLI::App& bench) {
+  CLI::App* command = bench.add_subcommand(
+      "sh", "spherical harmonics: reconstruction error against bands, irradiance error of 9 coefficients vs Monte Carlo");
+  command->footer(
+      "An analytic environment (sky gradient + coloured wall + small bright sun disk) projected on real SH:\n"
+      "(1) the radiance's RMS reconstruction error for 1, 3, 5, 7 bands, unwindowed and Hanning-windowed, from\n"
+      "exact coefficients, the seed's N x N jittered sampler and an N x N Gauss-Legendre product rule, with\n"
+      "projection times; (2) the irradiance error of 2, 3, 4 bands against a Monte Carlo reference (2^16\n"
+      "stratified cosine-weighted samples per normal).");
+  struct Options {
+    int samples = 200;
+    uint64_t seed = 1;
+  };
+  auto options = std::make_shared<Options>();
+  command->add_option("--samples", options->samples, "samples per axis of the jittered and product-rule projections")
+      ->check(CLI::Range(2, 2000));
+  command->add_option("--seed", options->seed, "jitter seed");
+  cli::on_run(command, [options] { return run_sh_benchmark(options->samples, options->seed); });
 }
 
 }  // namespace arpipe

@@ -10,6 +10,7 @@
 #include <exception>
 #include <filesystem>
 #include <limits>
+#include <memory>
 #include <mutex>
 #include <numbers>
 #include <numeric>
@@ -17,9 +18,10 @@
 #include <string>
 #include <vector>
 
-#include "apps/arpipe/commands.h"
-#include "apps/arpipe/progress_bar.h"
+#include "apps/cli/command_line.h"
+#include "apps/cli/progress_bar.h"
 #include "apps/common/pipeline_assembly.h"
+#include "bench/benchmarks.h"
 #include "capture/recording/recording_reader.h"
 #include "capture/sim/sim_scene_loader.h"
 #include "capture/sim/simulator.h"
@@ -32,16 +34,6 @@ namespace arpipe {
 namespace {
 
 namespace fs = std::filesystem;
-
-constexpr const char* kUsage =
-    "usage: arpipe bench blur [--capture DIR | --scene FILE] [--out DIR] [--frames N] [--reference-samples N]\n"
-    "                         [--config FILE] [--set KEY=VALUE]...\n"
-    "  --capture DIR   a recording with ground_truth_composite/ (default: simulate --scene into --out)\n"
-    "  --scene FILE    simulator scene (default configs/sim/blur-bench.toml)\n"
-    "  --out DIR       where the simulated capture goes (default out/bench-blur; reused when present)\n"
-    "  --frames N      simulate only the first N frames\n"
-    "  --reference-samples N   renders of the accumulate reference (default 256)\n"
-    "  --config FILE   pipeline config for the objects, light and lens (default: configs/arpipe.toml's cube)\n";
 
 struct Variant {
   std::string method;
@@ -187,44 +179,19 @@ Config bench_config(const fs::path& config_path, const std::vector<std::string>&
   return config;
 }
 
-}  // namespace
-
-int run_bench_blur(const Args& args) {
+struct BlurOptions {
   fs::path capture, scene_path = "configs/sim/blur-bench.toml", out_dir = "out/bench-blur", config_path;
   int frames_limit = 0, reference_samples = 256;
   std::vector<std::string> overrides;
-  for (size_t i = 0; i < args.size(); ++i) {
-    const std::string& key = args[i];
-    if (key == "--help" || key == "-h") {
-      std::fputs(kUsage, stdout);
-      return 0;
-    }
-    if (i + 1 >= args.size()) {
-      fmt::print(stderr, "arpipe bench blur: {} needs a value\n{}", key, kUsage);
-      return 2;
-    }
-    const std::string value = args[++i];
-    try {
-      if (key == "--capture") capture = value;
-      else if (key == "--scene") scene_path = value;
-      else if (key == "--out") out_dir = value;
-      else if (key == "--config") config_path = value;
-      else if (key == "--set") overrides.push_back(value);
-      else if (key == "--frames") frames_limit = std::stoi(value);
-      else if (key == "--reference-samples") reference_samples = std::stoi(value);
-      else {
-        fmt::print(stderr, "arpipe bench blur: unknown option {}\n{}", key, kUsage);
-        return 2;
-      }
-    } catch (const std::exception&) {
-      fmt::print(stderr, "arpipe bench blur: bad value '{}' for {}\n{}", value, key, kUsage);
-      return 2;
-    }
-  }
-  if (reference_samples < 2 || reference_samples > 1024 || frames_limit < 0) {
-    fmt::print(stderr, "arpipe bench blur: --reference-samples must be in [2, 1024] and --frames >= 0\n");
-    return 2;
-  }
+};
+
+int run_blur_benchmark(BlurOptions options) {
+  fs::path& capture = options.capture;
+  const fs::path& scene_path = options.scene_path;
+  const fs::path& out_dir = options.out_dir;
+  const fs::path& config_path = options.config_path;
+  const int frames_limit = options.frames_limit, reference_samples = options.reference_samples;
+  const std::vector<std::string>& overrides = options.overrides;
   try {
     if (capture.empty()) {
       capture = out_dir / "capture";
@@ -253,7 +220,7 @@ int run_bench_blur(const Args& args) {
     KeepContexts* kept = keep.get();
     std::vector<std::unique_ptr<FrameSink>> sinks;
     sinks.push_back(std::move(keep));
-    PipelineRunner runner(make_source(track_only), make_stage_factory(track_only), std::move(sinks), track_only);
+    PipelineRunner runner(make_source(track_only), make_stage_factory(), std::move(sinks), track_only);
     runner.start();
     runner.wait();
     std::vector<FrameContext> frames = std::move(kept->frames);
@@ -353,6 +320,31 @@ int run_bench_blur(const Args& args) {
     log::error("{}", e.what());
     return 1;
   }
+}
+
+}  // namespace
+
+void add_blur_benchmark(CLI::App& bench) {
+  CLI::App* command = bench.add_subcommand(
+      "blur", "motion-blur methods: time against error (PSNR, SSIM) vs the converged reference and the simulator's truth");
+  auto options = std::make_shared<BlurOptions>();
+  command->add_option("--capture", options->capture, "a recording with ground_truth_composite/")
+      ->type_name("DIR")
+      ->default_str("simulate --scene into --out");
+  command->add_option("--scene", options->scene_path, "the simulator scene")->type_name("FILE");
+  command->add_option("--out", options->out_dir, "where the simulated capture goes (reused when present)")
+      ->type_name("DIR");
+  command->add_option("--frames", options->frames_limit, "simulate only the first N frames (0: all)")
+      ->check(CLI::NonNegativeNumber);
+  command->add_option("--reference-samples", options->reference_samples, "renders of the accumulate reference")
+      ->check(CLI::Range(2, 1024));
+  command->add_option("--config", options->config_path, "pipeline config for the objects, light and lens")
+      ->type_name("FILE")
+      ->default_str("configs/arpipe.toml's cube");
+  command->add_option("--set", options->overrides, "override one config key (VALUE in TOML syntax); repeatable")
+      ->type_name("KEY=VALUE")
+      ->allow_extra_args(false);
+  cli::on_run(command, [options] { return run_blur_benchmark(*options); });
 }
 
 }  // namespace arpipe

@@ -1,61 +1,28 @@
 // arpipe bench shadows: each shadow method and map size, time per frame against the error of the
-// shadow on the ground relative to the simulator's ray-traced truth (apps/bench/shadow_comparison.h),
+// shadow on the ground relative to the simulator's ray-traced truth (bench/shadow_comparison.h),
 // on probe-indoor (a lamp, PCSS penumbra from its size) and sun-outdoor (the sun's 0.53 degrees).
 #include <fmt/format.h>
 
 #include <cstdio>
+#include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
-#include "apps/arpipe/commands.h"
-#include "apps/bench/shadow_comparison.h"
+#include "apps/cli/command_line.h"
+#include "bench/benchmarks.h"
+#include "bench/shadow_comparison.h"
 #include "core/log.h"
 
 namespace arpipe {
 namespace {
-
-constexpr const char* kUsage =
-    "usage: arpipe bench shadows [--frames N] [--scenes DIR]\n"
-    "  Draws the virtual ball of configs/sim/probe-indoor.toml and sun-outdoor.toml with every\n"
-    "  render.shadows method at map sizes 512, 1024 and 2048, the shadow map redrawn every frame,\n"
-    "  and prints the median shadow-map and render-stage times per frame beside the mean absolute\n"
-    "  error of the shadow ratio on the ground against the simulator's ray-traced truth.\n"
-    "  --frames N    frames per row (default 12)\n"
-    "  --scenes DIR  where the simulator scenes are (default configs/sim)\n";
 
 struct Row {
   std::string label, method;
   int pcf_kernel = 3;
 };
 
-}  // namespace
-
-int run_bench_shadows(const Args& args) {
-  int frames = 12;
-  std::filesystem::path scenes = "configs/sim";
-  for (size_t i = 0; i < args.size(); ++i) {
-    const auto value = [&]() -> const std::string& {
-      if (i + 1 >= args.size()) throw std::invalid_argument(fmt::format("{} needs a value", args[i]));
-      return args[++i];
-    };
-    try {
-      if (args[i] == "--frames") frames = std::stoi(value());
-      else if (args[i] == "--scenes") scenes = value();
-      else if (args[i] == "--help" || args[i] == "-h") {
-        std::fputs(kUsage, stdout);
-        return 0;
-      } else {
-        throw std::invalid_argument(fmt::format("unknown argument \"{}\"", args[i]));
-      }
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "arpipe bench shadows: %s\n%s", e.what(), kUsage);
-      return 2;
-    }
-  }
-  if (frames < 1 || frames > 1000) {
-    std::fprintf(stderr, "arpipe bench shadows: --frames must be in [1, 1000]\n");
-    return 2;
-  }
+int run_shadows_benchmark(int frames, const std::filesystem::path& scenes) {
   log::set_max_level(log::Level::Warning);
   const std::vector<Row> rows{{"hard (the seed's SM)", "hard"},   {"pcf 3x3", "pcf", 3}, {"pcf 8x8", "pcf", 8},
                               {"pcss", "pcss"},                   {"vsm (7-tap blur)", "vsm"},
@@ -90,6 +57,26 @@ int run_bench_shadows(const Args& args) {
     return 1;
   }
   return 0;
+}
+
+}  // namespace
+
+void add_shadows_benchmark(CLI::App& bench) {
+  CLI::App* command = bench.add_subcommand(
+      "shadows", "shadow methods and map sizes: time against the error of the shadow on the ground vs ray tracing");
+  command->footer(
+      "Draws the virtual ball of configs/sim/probe-indoor.toml and sun-outdoor.toml with every render.shadows\n"
+      "method at map sizes 512, 1024 and 2048, the shadow map redrawn every frame, and prints the median\n"
+      "shadow-map and render-stage times per frame beside the mean absolute error of the shadow ratio on the\n"
+      "ground against the simulator's ray-traced truth.");
+  struct Options {
+    int frames = 12;
+    std::filesystem::path scenes = "configs/sim";
+  };
+  auto options = std::make_shared<Options>();
+  command->add_option("--frames", options->frames, "frames per row")->check(CLI::Range(1, 1000));
+  command->add_option("--scenes", options->scenes, "where the simulator scenes are")->type_name("DIR");
+  cli::on_run(command, [options] { return run_shadows_benchmark(options->frames, options->scenes); });
 }
 
 }  // namespace arpipe

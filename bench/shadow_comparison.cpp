@@ -1,5 +1,5 @@
 // The virtual shadow against the ray-traced truth (see shadow_comparison.h).
-#include "apps/bench/shadow_comparison.h"
+#include "bench/shadow_comparison.h"
 
 #include <algorithm>
 #include <cmath>
