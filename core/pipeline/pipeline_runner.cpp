@@ -214,8 +214,9 @@ void PipelineRunner::swap_sinks(SinkSwap& swap) {
       // Everything it was handed is written and durable, and its output closed, before a new
       // sink may take over the same path.
       running->sink->flush();
-      log::info("{}: closed {}", key, running->sink->describe());
+      const std::string closed = running->sink->describe();
       running->sink.reset();
+      log::info("{}: closed {}", key, closed);
     }
     if (next) {
       next->run_started();
