@@ -4,11 +4,9 @@
 #include "core/image/srgb.h"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
-#include <string_view>
 
 namespace arpipe::sim {
 
@@ -62,25 +60,8 @@ SensorModel::SensorModel(const SimSensor& sensor) : sensor_(sensor) {
     throw std::invalid_argument("sensor.full_well_electrons must be a positive number");
   if (!(sensor.read_noise_electrons >= 0) || !std::isfinite(sensor.read_noise_electrons))
     throw std::invalid_argument("sensor.read_noise_electrons must be zero or positive");
-  const std::string_view response = sensor.response;
-  constexpr std::string_view kGammaPrefix = "gamma:";
-  if (response.starts_with(kGammaPrefix)) {
-    const std::string_view number = response.substr(kGammaPrefix.size());
-    double gamma = 0;
-    const auto [end, error] = std::from_chars(number.data(), number.data() + number.size(), gamma);
-    if (error != std::errc() || end != number.data() + number.size() || !(gamma > 0) || !std::isfinite(gamma))
-      throw std::invalid_argument("sensor.response \"" + sensor.response +
-                                  "\": expected gamma:<g> with g a positive number");
-    response_ = Response::Gamma;
-    gamma_ = gamma;
-  } else if (response == "srgb") {
-    response_ = Response::Srgb;
-  } else if (response == "linear") {
-    response_ = Response::Linear;
-  } else {
-    throw std::invalid_argument("sensor.response \"" + sensor.response +
-                                "\": expected \"srgb\", \"linear\" or \"gamma:<g>\"");
-  }
+  response_ = sensor.response.kind();
+  gamma_ = sensor.response.gamma_value();
 }
 
 double SensorModel::expected_value(double radiance, const SensorExposure& exposure) const {
@@ -105,9 +86,9 @@ double SensorModel::noisy_value(double radiance, const SensorExposure& exposure,
 double SensorModel::encode(double linear_value) const {
   const double v = clip_unit(linear_value);
   switch (response_) {
-    case Response::Srgb: return srgb_encode(v);
-    case Response::Gamma: return std::pow(v, 1.0 / gamma_);
-    case Response::Linear: break;
+    case CameraResponse::Kind::Srgb: return srgb_encode(v);
+    case CameraResponse::Kind::Gamma: return std::pow(v, 1.0 / gamma_);
+    case CameraResponse::Kind::Linear: break;
   }
   return v;
 }
@@ -115,9 +96,9 @@ double SensorModel::encode(double linear_value) const {
 double SensorModel::decode(double encoded_value) const {
   const double e = clip_unit(encoded_value);
   switch (response_) {
-    case Response::Srgb: return srgb_decode(e);
-    case Response::Gamma: return std::pow(e, gamma_);
-    case Response::Linear: break;
+    case CameraResponse::Kind::Srgb: return srgb_decode(e);
+    case CameraResponse::Kind::Gamma: return std::pow(e, gamma_);
+    case CameraResponse::Kind::Linear: break;
   }
   return e;
 }

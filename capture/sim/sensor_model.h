@@ -17,8 +17,8 @@ struct SensorExposure {
 
 class SensorModel {
  public:
-  // Validated by the loader; still throws std::invalid_argument on an unknown response curve or a
-  // non-positive full well, naming the key.
+  // Validated by the loader; still throws std::invalid_argument on a non-positive full well or a
+  // negative read noise, naming the key.
   explicit SensorModel(const SimSensor& sensor);
 
   // The noise-free linear value (full scale 1.0) after both gains, before clipping.
@@ -35,9 +35,8 @@ class SensorModel {
   static uint8_t quantize(double encoded_value);
 
  private:
-  enum class Response { Srgb, Linear, Gamma };
   SimSensor sensor_;
-  Response response_ = Response::Srgb;
+  CameraResponse::Kind response_ = CameraResponse::Kind::Srgb;
   double gamma_ = 0;  // the g of "gamma:<g>"
 };
 

@@ -13,6 +13,7 @@
 #include "core/frame.h"
 #include "core/geometry/camera_model.h"
 #include "core/geometry/se3.h"
+#include "core/image/camera_response.h"
 #include "core/pixel_format.h"
 
 namespace arpipe::sim {
@@ -148,7 +149,7 @@ struct SimSensor {
   double full_well_electrons = 10000.0;
   double read_noise_electrons = 3.0;
   bool noise = true;                    // false: a noise-free sensor (exact tests)
-  std::string response = "srgb";        // "srgb", "linear" or "gamma:<g>" (value^(1/g))
+  CameraResponse response;              // "srgb" (default), "linear" or "gamma:<g>" (value^(1/g))
 };
 
 // Auto-exposure: after each frame, scale the next exposure so the mean linear value of the frame

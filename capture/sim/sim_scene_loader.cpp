@@ -170,16 +170,13 @@ CameraModel read_camera_model(const TomlSection& s) {
   }
 }
 
-// "srgb", "linear" or "gamma:<g>" with g > 0.
-std::optional<std::string> response_curve(std::string_view text) {
-  if (text == "srgb" || text == "linear") return std::string(text);
-  if (!text.starts_with("gamma:")) return std::nullopt;
-  const std::string number(text.substr(6));
-  char* end = nullptr;
-  const double gamma = std::strtod(number.c_str(), &end);
-  if (number.empty() || end != number.c_str() + number.size() || !std::isfinite(gamma) || gamma <= 0)
+// "srgb", "linear" or "gamma:<g>" with g > 0, as CameraResponse reads it.
+std::optional<CameraResponse> response_curve(std::string_view text) {
+  try {
+    return CameraResponse::parse(text, "camera.sensor.response");
+  } catch (const std::invalid_argument&) {
     return std::nullopt;
-  return std::string(text);
+  }
 }
 
 SimCamera read_camera(const TomlSection& s) {
@@ -272,7 +269,7 @@ SimCamera read_camera(const TomlSection& s) {
     out.full_well_electrons = sensor->number("full_well_electrons", out.full_well_electrons, kPositive);
     out.read_noise_electrons = sensor->number("read_noise_electrons", out.read_noise_electrons, kNonNegative);
     out.noise = sensor->boolean("noise", out.noise);
-    out.response = sensor->parsed<std::string>("response", out.response, response_curve,
+    out.response = sensor->parsed<CameraResponse>("response", out.response, response_curve,
                                                "\"srgb\", \"linear\" or \"gamma:<g>\" with g > 0");
   }
   return camera;

@@ -18,7 +18,7 @@ SimSensor linear_sensor(bool noise) {
   sensor.full_well_electrons = 10000.0;
   sensor.read_noise_electrons = 3.0;
   sensor.noise = noise;
-  sensor.response = "linear";
+  sensor.response = CameraResponse::linear();
   return sensor;
 }
 
@@ -138,7 +138,7 @@ TEST(SensorModel, NoisyValueIsDeterministicPerStream) {
 
 TEST(SensorModel, SrgbMatchesThePublishedCurve) {
   SimSensor config;
-  config.response = "srgb";
+  config.response = CameraResponse::srgb();
   const SensorModel sensor(config);
   // IEC 61966-2-1: the linear segment ends at 0.0031308 -> 12.92 x 0.0031308 = 0.040449936.
   EXPECT_NEAR(sensor.encode(0.0031308), 0.04045, 1e-6);
@@ -160,7 +160,7 @@ TEST(SensorModel, SrgbMatchesThePublishedCurve) {
 TEST(SensorModel, DecodeInvertsEncodeForEveryCurve) {
   for (const char* response : {"srgb", "linear", "gamma:2.2", "gamma:1.8"}) {
     SimSensor config;
-    config.response = response;
+    config.response = CameraResponse::parse(response, "sensor.response");
     const SensorModel sensor(config);
     double previous = -1;
     for (int i = 0; i <= 10000; ++i) {
@@ -177,10 +177,10 @@ TEST(SensorModel, DecodeInvertsEncodeForEveryCurve) {
 
 TEST(SensorModel, GammaAndLinearCurves) {
   SimSensor config;
-  config.response = "gamma:2.2";
+  config.response = CameraResponse::gamma(2.2);
   EXPECT_NEAR(SensorModel(config).encode(0.5), std::pow(0.5, 1 / 2.2), 1e-15);
   EXPECT_NEAR(SensorModel(config).decode(0.5), std::pow(0.5, 2.2), 1e-15);
-  config.response = "linear";
+  config.response = CameraResponse::linear();
   EXPECT_EQ(SensorModel(config).encode(0.3), 0.3);
   EXPECT_EQ(SensorModel(config).decode(0.3), 0.3);
 }
@@ -202,9 +202,8 @@ TEST(SensorModel, QuantizeRoundsAndClampsTo8Bits) {
 
 TEST(SensorModel, RejectsBadConfiguration) {
   for (const char* response : {"gamma:", "gamma:0", "gamma:-2", "gamma:abc", "gamma:2x", "log", "", "SRGB"}) {
-    SimSensor config;
-    config.response = response;
-    EXPECT_THROW(SensorModel{config}, std::invalid_argument) << response;
+    // The scene loader reads the curve through CameraResponse: it refuses these before a sensor exists.
+    EXPECT_THROW(CameraResponse::parse(response, "sensor.response"), std::invalid_argument) << response;
   }
   SimSensor config;
   config.full_well_electrons = 0;

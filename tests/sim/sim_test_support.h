@@ -31,7 +31,7 @@ inline SimCamera exact_camera(int width, int height, double focal_px) {
   camera.model = CameraModel::pinhole(focal_px, focal_px, (width - 1) / 2.0, (height - 1) / 2.0, width, height);
   camera.pixel_format = PixelFormat::RGB24;
   camera.sensor.noise = false;
-  camera.sensor.response = "linear";
+  camera.sensor.response = CameraResponse::linear();
   return camera;
 }
 

@@ -26,7 +26,7 @@ TEST(SimulatorTags, OuterCornersLandWhereMrcalProjectsThem) {
   scene.camera.model =
       CameraModel("LENSMODEL_OPENCV4", {430, 430, 238.0, 181.5, -0.05, 0.012, 0.0004, -0.0003}, width, height);
   scene.camera.pixel_format = PixelFormat::GREY;
-  scene.camera.sensor.response = "srgb";  // what the corner refiner decodes
+  scene.camera.sensor.response = CameraResponse::srgb();  // what the corner refiner decodes
   scene.camera.sensor.sensitivity = 1000;
   scene.camera.exposure_ns = {1'000'000};
   // Two tags of 6 cm (black-border edge) at known places on a grey table.
