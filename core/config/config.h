@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "core/config/config_rules.h"
 #include "core/geometry/vec.h"
 
 namespace arpipe {
@@ -49,6 +50,40 @@ struct SourceConfig {
   bool operator==(const SourceConfig&) const = default;
 };
 
+// Its keys, one row each: the name in the file, the member (whose initializer is the default), the
+// rule the value must meet, and the help `arpipe config --defaults` prints (docs/ARCHITECTURE.md, "Adding a config key").
+template <class V>
+void visit(V& v, SourceConfig& s) {
+  v.key("type", s.type, OneOf{{"replay", "v4l2", "libcamera"}}, "a recording, a V4L2 device or a libcamera camera");
+  v.key("path", s.path, "replay: the recording directory");
+  v.key("pacing", s.pacing, OneOf{{"timestamps", "fast"}}, "replay: real time, or as fast as the pipeline runs");
+  v.key("loop", s.loop, "replay: start again at the end (soak tests)");
+  // Drivers disagree about their timestamps by a frame or two; an hour keeps every exposure time
+  // plus the offset inside int64 nanoseconds.
+  v.key("timestamp_offset_ns", s.timestamp_offset_ns, IntRange{-3'600'000'000'000, 3'600'000'000'000},
+        "added to every exposure start of this camera");
+  v.key("camera_model", s.camera_model, "a .cameramodel to use instead of the recording's (live: needed to track)");
+  v.key("device", s.device, "v4l2: /dev/videoN or a /dev/v4l/by-id or by-path link");
+  v.key("camera", s.camera, "libcamera: a camera id or index (\"\": the first)");
+  v.key("role", s.role, OneOf{{"video", "viewfinder", "still", "raw"}}, "libcamera stream role");
+  v.key("width", s.width, IntRange{0, 16384}, "live: 0 = the camera's first size");
+  v.key("height", s.height, IntRange{0, 16384}, "live: 0 = the camera's first size");
+  v.key("fps", s.fps, NumberRange::at_least(0), "live: 0 = the camera's default rate");
+  v.key("pixel_format", s.pixel_format, OneOf{{"auto", "YUYV", "NV12", "RGB24", "GREY", "MJPG"}},
+        "live: MJPG is decoded to RGB24; auto: what the camera offers first");
+  // Fewer than 4 starves the driver while one buffer is being converted.
+  v.key("buffers", s.buffers, IntRange{4, 32}, "capture buffers");
+  v.key("exposure_us", s.exposure_us, IntRange{0, 60'000'000}, "manual exposure; 0 = auto exposure");
+  v.key("gain", s.gain, NumberRange::at_least(0), "manual analogue gain (1 = unity); 0 = auto");
+  v.key("gain_unity", s.gain_unity, NumberRange::above(0), "v4l2: the gain control value that means gain 1");
+  v.key("timestamp_meaning", s.timestamp_meaning, OneOf{{"auto", "start-of-exposure", "end-of-frame"}},
+        "v4l2: what buffer timestamps mean when the driver does not say; auto: the driver's flag");
+  v.key("readout_ns", s.readout_ns, IntRange{0, 1'000'000'000}, "rolling-shutter readout time; 0 = global shutter");
+  v.key("frame_timeout_ms", s.frame_timeout_ms, IntRange{1, 600'000}, "a frame later than this is a timeout");
+  v.key("reconnect_min_ms", s.reconnect_min_ms, IntRange{1, 600'000}, "first retry after the camera went away");
+  v.key("reconnect_max_ms", s.reconnect_max_ms, IntRange{1, 3'600'000}, "retries back off up to this (>= reconnect_min_ms)");
+}
+
 // One tag of the anchor bundle: where its centre sits in the world (anchor) frame and how it is turned.
 struct BundleTag {
   int id = 0;
@@ -58,6 +93,17 @@ struct BundleTag {
 
   bool operator==(const BundleTag&) const = default;
 };
+
+// Its keys, one row each: the name in the file, the member (whose initializer is the default), the
+// rule the value must meet, and the help `arpipe config --defaults` prints (docs/ARCHITECTURE.md, "Adding a config key").
+template <class V>
+void visit(V& v, BundleTag& s) {
+  // Its range depends on the family: checked after the rows (config_reader.cpp).
+  v.key("id", s.id, IntRange{}, "unique, and in [0, the family's code count)");
+  v.key("size_m", s.size_m, NumberRange::above(0), "edge of the black square (AprilTag's tag size)");
+  v.key("center_m", s.center_m, "tag centre in the world frame");
+  v.key("yaw_deg", s.yaw_rad, Degrees{}, "turn of the tag's x axis about world z");
+}
 
 struct TrackConfig {
   bool enabled = true;
@@ -81,6 +127,28 @@ struct TrackConfig {
   bool operator==(const TrackConfig&) const = default;
 };
 
+// Its keys, one row each: the name in the file, the member (whose initializer is the default), the
+// rule the value must meet, and the help `arpipe config --defaults` prints (docs/ARCHITECTURE.md, "Adding a config key").
+template <class V>
+void visit(V& v, TrackConfig& s) {
+  v.key("enabled", s.enabled, "find the anchor's tags and the camera's pose");
+  v.key("family", s.family, TagFamilyName{}, "libapriltag's tag family");
+  v.key("quad_decimate", s.quad_decimate, NumberRange::at_least(1), "find quads in an image this many times smaller");
+  // Negative sharpens in libapriltag, so any value goes.
+  v.key("quad_sigma", s.quad_sigma, "blur before finding quads (negative sharpens)");
+  v.key("threads", s.threads, IntRange{1, 64}, "detector threads");
+  // libapriltag corrects at most 3 bits.
+  v.key("max_hamming", s.max_hamming, IntRange{0, 3}, "bit errors corrected");
+  v.key("min_decision_margin", s.min_decision_margin, NumberRange::at_least(0), "weaker detections are ignored");
+  v.key("ambiguity_ratio", s.ambiguity_ratio, NumberRange::at_least(1),
+        "IPPE's two poses closer than this error ratio are ambiguous");
+  v.key("refine_corners", s.refine_corners, "re-fit the tag borders in linear light (libapriltag's corners sit ~0.2 px inside)");
+  // A second of prediction at 30 fps is already far beyond what constant velocity predicts well.
+  v.key("max_predicted_frames", s.max_predicted_frames, IntRange{0, 30},
+        "frames without a detection whose pose is predicted at constant velocity (0: none)");
+  v.sections("bundle", s.bundle, "the anchor: one [[track.bundle]] per tag, placed in the world (anchor) frame, lying in z = 0");
+}
+
 // The shutter-motion stage (core/motion): the camera's poses over each exposure.
 struct MotionConfig {
   bool enabled = true;  // runs only while tracking is on
@@ -93,6 +161,22 @@ struct MotionConfig {
 
   bool operator==(const MotionConfig&) const = default;
 };
+
+// Its keys, one row each: the name in the file, the member (whose initializer is the default), the
+// rule the value must meet, and the help `arpipe config --defaults` prints (docs/ARCHITECTURE.md, "Adding a config key").
+template <class V>
+void visit(V& v, MotionConfig& s) {
+  v.key("enabled", s.enabled, "runs only while tracking is on");
+  // Only the previous-current (0) or current-next (1) segment is implemented; holding more frames
+  // would add latency without a better estimate of one exposure.
+  v.key("latency_frames", s.latency_frames,
+        OneOfInts{{0, 1}, "0 (extrapolate, no delay) or 1 (hold each frame back by one and interpolate)"},
+        "0: extrapolate at constant velocity; 1: hold a frame back and interpolate");
+  // Up to one second: longer than any frame interval a tracking camera runs at. The stage caps it
+  // at each frame's own interval, and frames with their own exposure never use it.
+  v.key("default_exposure_ms", s.default_exposure_ns, MillisecondsAsNs{NumberRange::open_closed(0, 1000).in("ms")},
+        "for frames without an exposure time; capped at the frame interval");
+}
 
 struct SceneObject {
   std::string mesh = "builtin:cube";   // "builtin:cube", "builtin:pyramid", or a glTF 2.0 file
@@ -111,6 +195,21 @@ struct SceneObject {
   bool operator==(const SceneObject&) const = default;
 };
 
+// Its keys, one row each: the name in the file, the member (whose initializer is the default), the
+// rule the value must meet, and the help `arpipe config --defaults` prints (docs/ARCHITECTURE.md, "Adding a config key").
+template <class V>
+void visit(V& v, SceneObject& s) {
+  v.key("mesh", s.mesh, NotEmpty{"\"builtin:cube\", \"builtin:pyramid\" or a glTF file"},
+        "\"builtin:cube\", \"builtin:pyramid\" or a glTF 2.0 file");
+  v.key("position_m", s.position_m, "in the world (anchor) frame");
+  v.key("yaw_deg", s.yaw_rad, Degrees{}, "about world z");
+  v.key("scale", s.scale, NumberRange::above(0), "size factor");
+  v.key("color", s.color, NumberRange::at_least(0), "linear base colour of builtin meshes");
+  v.key("prt", s.prt, OneOf{{"off", "unshadowed", "shadowed", "interreflected"}},
+        "environment light: off (SH irradiance at each normal) or the baked transfer ([render.prt])");
+  v.key("specular", s.specular, NumberRange::closed(0, 1), "glossy reflection of the environment, added untinted");
+}
+
 // Motion blur of the virtual layer (docs/ARCHITECTURE.md, "Motion blur"): how the virtual objects
 // are smeared over each exposure to match the camera's own blur.
 struct BlurConfig {
@@ -125,6 +224,18 @@ struct BlurConfig {
 
   bool operator==(const BlurConfig&) const = default;
 };
+
+// Its keys, one row each: the name in the file, the member (whose initializer is the default), the
+// rule the value must meet, and the help `arpipe config --defaults` prints (docs/ARCHITECTURE.md, "Adding a config key").
+template <class V>
+void visit(V& v, BlurConfig& s) {
+  v.key("method", s.method, OneOf{{"off", "accumulate", "seed", "velocity"}},
+        "accumulate: N renders (the reference); seed: 2 renders + affine warps; velocity: fastest");
+  // 1024: far beyond what converges (bench blur's reference uses 256); the seed method caps at 50.
+  v.key("samples", s.samples, IntRange{0, 1024}, "0: from the frame's image motion");
+  v.key("min_motion_px", s.min_motion_px, NumberRange::closed(0, 1000).in("pixels"),
+        "frames with less image motion are drawn sharp");
+}
 
 // Shadows of the virtual objects on themselves and on the real ground (docs/ARCHITECTURE.md,
 // "Light and shadows"): a shadow map from the directional light, filtered by `method`.
@@ -146,6 +257,22 @@ struct ShadowConfig {
   bool operator==(const ShadowConfig&) const = default;
 };
 
+// Its keys, one row each: the name in the file, the member (whose initializer is the default), the
+// rule the value must meet, and the help `arpipe config --defaults` prints (docs/ARCHITECTURE.md, "Adding a config key").
+template <class V>
+void visit(V& v, ShadowConfig& s) {
+  v.key("method", s.method, OneOf{{"off", "hard", "pcf", "pcss", "vsm", "vsm-packed"}},
+        "hard: binary; pcf: k x k filter; pcss: penumbra from the light's size; vsm-packed: RGBA8 moments");
+  v.key("map_size", s.map_size, OneOfInts{{256, 512, 1024, 2048, 4096}, ""}, "texels across");
+  v.key("pcf_kernel", s.pcf_kernel, IntRange{1, 16}, "pcf: k x k taps");
+  v.key("vsm_blur", s.vsm_blur, IntRange{1, 31}, "vsm: Gaussian taps across, odd");
+  v.key("vsm_bleed_reduction", s.vsm_bleed_reduction, NumberRange::closed_open(0, 0.95), "vsm: cuts light bleeding");
+  v.key("depth_bias_texels", s.depth_bias_texels, NumberRange::closed(0, 100).in("texels"), "self-shadowing bias");
+  v.key("receiver_height_m", s.receiver_height_m, "world z of the real ground");
+  v.key("light_angular_diameter_deg", s.light_angular_diameter_deg, NumberRange::closed_open(0, 90).in("degrees"),
+        "size of the fixed light (pcss); estimates bring their own");
+}
+
 // The precomputed radiance transfer bake (render/prt): run once per mesh and kept in a cache
 // keyed by the mesh's content.
 struct PrtConfig {
@@ -155,6 +282,15 @@ struct PrtConfig {
 
   bool operator==(const PrtConfig&) const = default;
 };
+
+// Its keys, one row each: the name in the file, the member (whose initializer is the default), the
+// rule the value must meet, and the help `arpipe config --defaults` prints (docs/ARCHITECTURE.md, "Adding a config key").
+template <class V>
+void visit(V& v, PrtConfig& s) {
+  v.key("samples", s.samples, IntRange{2, 256}, "per axis: samples^2 directions per vertex");
+  v.key("bands", s.bands, IntRange{3, 8}, "SH bands baked (the shader uses 3)");
+  v.key("cache_dir", s.cache_dir, "\"\": $XDG_CACHE_HOME/arpipe/prt, else ~/.cache/arpipe/prt");
+}
 
 struct RenderConfig {
   bool enabled = true;
@@ -192,6 +328,35 @@ struct RenderConfig {
   bool operator==(const RenderConfig&) const = default;
 };
 
+// Its keys, one row each: the name in the file, the member (whose initializer is the default), the
+// rule the value must meet, and the help `arpipe config --defaults` prints (docs/ARCHITECTURE.md, "Adding a config key").
+template <class V>
+void visit(V& v, RenderConfig& s) {
+  v.key("enabled", s.enabled, "draw the virtual objects");
+  v.key("light_direction", s.light_direction, "world frame, towards the light; normalised on load");
+  v.key("light_distance_m", s.light_distance_m, NumberRange::closed(0, 1e6).in("m; 0: infinitely far"),
+        "0: infinitely far; > 0: a lamp that far along light_direction");
+  v.key("light_color", s.light_color, NumberRange::at_least(0), "linear RGB");
+  v.key("ambient", s.ambient, NumberRange::at_least(0), "linear RGB");
+  v.key("msaa_samples", s.msaa_samples, OneOfInts{{0, 1, 2, 4}, ""}, "multisampling");
+  v.key("egl_platform", s.egl_platform, OneOf{{"auto", "surfaceless", "device"}}, "EGL platform");
+  v.key("lens", s.lens, OneOf{{"map", "vertex", "undistort"}},
+        "how the virtual layer matches the real lens: map: draw pinhole on an enlarged canvas, warp through a "
+        "per-pixel map (any lens mrcal can unproject); vertex: distort per vertex (PINHOLE, OPENCV4/5/8); "
+        "undistort: undistort the camera frame to the pinhole core and draw pinhole");
+  // 4x multisampling alone leaves a straight edge up to 1/8 canvas pixel off; a finer canvas
+  // divides that, at its square in fill and memory (tests/render/lens_matched_rendering_test.cpp).
+  v.key("lens_canvas_scale", s.lens_canvas_scale, NumberRange::closed(1, 4),
+        "\"map\": canvas pixels per core pixel; finer edges, cost grows with its square");
+  v.key("rolling_shutter", s.rolling_shutter, "draw each row with its own exposure's pose when the readout time is non-zero");
+  v.key("max_predicted_uncertainty_deg", s.max_predicted_uncertainty_deg, NumberRange::closed(0, 180).in("degrees"),
+        "a predicted pose less certain than this is not drawn");
+  v.section("blur", s.blur, "motion blur of the virtual layer over each exposure");
+  v.section("shadows", s.shadows, "shadows of the virtual objects, on themselves and on the real ground");
+  v.section("prt", s.prt, "precomputed radiance transfer, baked once per mesh (arpipe bake)");
+  v.sections("objects", s.objects, "virtual objects: one [[render.objects]] each, placed in the world (anchor) frame");
+}
+
 // A light probe sphere beside the anchor (core/light): where it is and what it is made of.
 struct ProbeConfig {
   std::string kind = "mirror";           // "mirror" or "diffuse"
@@ -208,6 +373,21 @@ struct ProbeConfig {
 
   bool operator==(const ProbeConfig&) const = default;
 };
+
+// Its keys, one row each: the name in the file, the member (whose initializer is the default), the
+// rule the value must meet, and the help `arpipe config --defaults` prints (docs/ARCHITECTURE.md, "Adding a config key").
+template <class V>
+void visit(V& v, ProbeConfig& s) {
+  v.key("kind", s.kind, OneOf{{"mirror", "diffuse"}}, "what the sphere is made of");
+  v.key("center_m", s.center_m, "world frame");
+  v.key("radius_m", s.radius_m, NumberRange::open_closed(0, 10).in("m"), "the sphere's radius");
+  v.key("reflectance", s.reflectance, NumberRange::open_closed(0, 1), "mirror reflectance, or the diffuse sphere's albedo");
+  v.key("method", s.method, OneOf{{"auto", "environment", "fit", "seed-image", "seed-sphere"}},
+        "auto: environment for a mirror, fit for a diffuse sphere; seed-*: the brightest components");
+  v.key("max_lights", s.max_lights, IntRange{1, 4}, "dominant lights kept");
+  v.key("light_distance_m", s.light_distance_m, NumberRange::closed(0, 1e6).in("m; 0: infinitely far"),
+        "0: lights infinitely far; > 0: the key lamp's distance from the probe");
+}
 
 // The sun from place and time (core/light): NREL's SPA, turned into the anchor frame.
 struct SunConfig {
@@ -228,6 +408,23 @@ struct SunConfig {
   bool operator==(const SunConfig&) const = default;
 };
 
+// Its keys, one row each: the name in the file, the member (whose initializer is the default), the
+// rule the value must meet, and the help `arpipe config --defaults` prints (docs/ARCHITECTURE.md, "Adding a config key").
+template <class V>
+void visit(V& v, SunConfig& s) {
+  v.key("latitude_deg", s.latitude_deg, NumberRange::closed(-90, 90).in("degrees, north positive"), "north positive");
+  v.key("longitude_deg", s.longitude_deg, NumberRange::closed(-180, 180).in("degrees, east positive"), "east positive");
+  v.key("altitude_m", s.altitude_m, NumberRange::closed(-500, 20000).in("m"), "above sea level");
+  v.key("time", s.time, "\"now\" (system UTC clock) or an ISO 8601 instant for the first frame");
+  v.key("heading_deg", s.heading_deg, NumberRange::closed(-360, 360).in("degrees"),
+        "bearing of the anchor's +y axis from true north, clockwise");
+  v.key("declination_deg", s.declination_deg, NumberRange::closed(-180, 180).in("degrees, east positive"),
+        "magnetic declination, east positive, for a compass heading");
+  v.key("pressure_mbar", s.pressure_mbar, NumberRange::open_closed(0, 5000).in("mbar"), "for refraction");
+  v.key("temperature_c", s.temperature_c, NumberRange::open_closed(-273, 6000).in("degrees Celsius"), "for refraction");
+  v.key("direct_fraction", s.direct_fraction, NumberRange::closed(0, 1), "the sun's share of the light on the ground");
+}
+
 // A light probe image file as the whole light (static): an HDR panorama of the place, projected
 // onto spherical harmonics once at configure.
 struct EnvironmentConfig {
@@ -239,6 +436,17 @@ struct EnvironmentConfig {
 
   bool operator==(const EnvironmentConfig&) const = default;
 };
+
+// Its keys, one row each: the name in the file, the member (whose initializer is the default), the
+// rule the value must meet, and the help `arpipe config --defaults` prints (docs/ARCHITECTURE.md, "Adding a config key").
+template <class V>
+void visit(V& v, EnvironmentConfig& s) {
+  v.key("file", s.file, "Radiance .hdr or OpenEXR .exr; required with source = \"environment\"");
+  v.key("layout", s.layout, OneOf{{"angular", "mirror-ball", "equirect", "cube-cross"}}, "the file's projection");
+  v.key("yaw_deg", s.yaw_rad, Degrees{}, "turn of the probe about world z (probe up = world z)");
+  v.key("scale", s.scale, NumberRange::open_closed(0, 1e12), "the file's radiance units to scene-linear units");
+  v.key("window", s.window, OneOf{{"none", "hanning", "lanczos"}}, "SH windowing against ringing");
+}
 
 // The light stage: where the light comes from.
 struct LightConfig {
@@ -258,6 +466,21 @@ struct LightConfig {
   bool operator==(const LightConfig&) const = default;
 };
 
+// Its keys, one row each: the name in the file, the member (whose initializer is the default), the
+// rule the value must meet, and the help `arpipe config --defaults` prints (docs/ARCHITECTURE.md, "Adding a config key").
+template <class V>
+void visit(V& v, LightConfig& s) {
+  v.key("source", s.source, OneOf{{"fixed", "probe", "sun", "environment"}},
+        "fixed: render.light_*; probe: a probe sphere in view; sun: place and time; environment: an HDR probe file");
+  v.key("response", s.response, CameraResponseName{}, "the camera's response curve");
+  v.key("smoothing_s", s.smoothing_s, NumberRange::closed(0, 60).in("s"), "time constant of the temporal smoothing");
+  v.key("ground_albedo", s.ground_albedo, NumberRange::open_closed(0, 1),
+        "of the real ground, whose brightness sets the sun's level and a clipped lamp's");
+  v.section("probe", s.probe, "a light probe sphere beside the anchor");
+  v.section("sun", s.sun, "the sun from place and time (NREL SPA)");
+  v.section("environment", s.environment, "an HDR light probe file as the whole light");
+}
+
 struct PngSinkConfig {
   bool enabled = true;
   std::filesystem::path dir = "out/png";
@@ -265,24 +488,57 @@ struct PngSinkConfig {
 
   bool operator==(const PngSinkConfig&) const = default;
 };
+
+// Its keys, one row each: the name in the file, the member (whose initializer is the default), the
+// rule the value must meet, and the help `arpipe config --defaults` prints (docs/ARCHITECTURE.md, "Adding a config key").
+template <class V>
+void visit(V& v, PngSinkConfig& s) {
+  v.key("enabled", s.enabled, "write PNG frames");
+  v.key("dir", s.dir, "the directory the frames go to");
+  v.key("every", s.every, IntRange{1}, "write every Nth frame");
+}
 struct Y4mSinkConfig {
   bool enabled = true;
   std::filesystem::path path = "out/arpiped.y4m";
 
   bool operator==(const Y4mSinkConfig&) const = default;
 };
+
+// Its keys, one row each: the name in the file, the member (whose initializer is the default), the
+// rule the value must meet, and the help `arpipe config --defaults` prints (docs/ARCHITECTURE.md, "Adding a config key").
+template <class V>
+void visit(V& v, Y4mSinkConfig& s) {
+  v.key("enabled", s.enabled, "write a Y4M video");
+  v.key("path", s.path, "the video file");
+}
 struct RecordingSinkConfig {
   bool enabled = false;
   std::filesystem::path path = "out/composited";
 
   bool operator==(const RecordingSinkConfig&) const = default;
 };
+
+// Its keys, one row each: the name in the file, the member (whose initializer is the default), the
+// rule the value must meet, and the help `arpipe config --defaults` prints (docs/ARCHITECTURE.md, "Adding a config key").
+template <class V>
+void visit(V& v, RecordingSinkConfig& s) {
+  v.key("enabled", s.enabled, "write a recording (replayable)");
+  v.key("path", s.path, "the recording directory");
+}
 struct ResultsSinkConfig {
   bool enabled = true;
   std::filesystem::path path = "out/results.jsonl";  // per-frame pose, tracking state, timings
 
   bool operator==(const ResultsSinkConfig&) const = default;
 };
+
+// Its keys, one row each: the name in the file, the member (whose initializer is the default), the
+// rule the value must meet, and the help `arpipe config --defaults` prints (docs/ARCHITECTURE.md, "Adding a config key").
+template <class V>
+void visit(V& v, ResultsSinkConfig& s) {
+  v.key("enabled", s.enabled, "write per-frame results");
+  v.key("path", s.path, "per-frame pose, tracking state and timings as JSON lines");
+}
 
 struct SinksConfig {
   PngSinkConfig png;
@@ -293,6 +549,16 @@ struct SinksConfig {
   bool operator==(const SinksConfig&) const = default;
 };
 
+// Its keys, one row each: the name in the file, the member (whose initializer is the default), the
+// rule the value must meet, and the help `arpipe config --defaults` prints (docs/ARCHITECTURE.md, "Adding a config key").
+template <class V>
+void visit(V& v, SinksConfig& s) {
+  v.section("png", s.png, "composited frames as PNG files");
+  v.section("y4m", s.y4m, "composited frames as a Y4M video");
+  v.section("recording", s.recording, "composited frames as a recording");
+  v.section("results", s.results, "per-frame pose, tracking state and timings as JSON lines");
+}
+
 struct PipelineConfig {
   int queue_depth = 4;
   int64_t max_frames = 0;  // 0 = no limit
@@ -300,6 +566,15 @@ struct PipelineConfig {
 
   bool operator==(const PipelineConfig&) const = default;
 };
+
+// Its keys, one row each: the name in the file, the member (whose initializer is the default), the
+// rule the value must meet, and the help `arpipe config --defaults` prints (docs/ARCHITECTURE.md, "Adding a config key").
+template <class V>
+void visit(V& v, PipelineConfig& s) {
+  v.key("queue_depth", s.queue_depth, IntRange{1}, "frames between threads");
+  v.key("max_frames", s.max_frames, IntRange{0}, "stop after this many frames; 0 = no limit");
+  v.key("log_level", s.log_level, OneOf{{"error", "warning", "info", "debug"}}, "what the daemon logs");
+}
 
 struct Config {
   std::filesystem::path file;  // where it came from, for messages
@@ -313,6 +588,19 @@ struct Config {
 
   bool operator==(const Config&) const = default;
 };
+
+// Its keys, one row each: the name in the file, the member (whose initializer is the default), the
+// rule the value must meet, and the help `arpipe config --defaults` prints (docs/ARCHITECTURE.md, "Adding a config key").
+template <class V>
+void visit(V& v, Config& s) {
+  v.section("source", s.source, "the camera");
+  v.section("track", s.track, "the anchor's tags and the camera's pose");
+  v.section("motion", s.motion, "the camera's poses over each exposure (needs tracking)");
+  v.section("light", s.light, "where the light comes from");
+  v.section("render", s.render, "the virtual layer");
+  v.section("sinks", s.sinks, "where the composited frames and results go");
+  v.section("pipeline", s.pipeline, "threads and limits");
+}
 
 // Loads a config file. Throws ConfigError naming the file and the place on any problem:
 // unreadable file, TOML syntax, unknown key, wrong type, value out of range.

@@ -208,6 +208,9 @@ TomlSection::TomlSection(const toml::table& table, std::string dotted, std::stri
 }
 
 TomlSection TomlSection::child(const toml::table& table, std::string dotted, std::string header) const {
+  // Opening the same table again (a later check that points at a key) shares what was asked of it.
+  for (const auto& existing : record_->children)
+    if (existing->table == &table) return TomlSection(table, std::move(dotted), std::move(header), shared_, existing);
   auto record = std::make_shared<Record>();
   record_->children.push_back(record);
   return TomlSection(table, std::move(dotted), std::move(header), shared_, std::move(record));

@@ -37,7 +37,8 @@
 
 #include "core/config/choice_names.h"
 #include "core/config/toml_text.h"
-#include "core/config/toml_type_phrase.h"  // "a string", "a table": what a node is, for "found ..."
+#include "core/config/toml_type_phrase.h"
+#include "core/config/value_ranges.h"  // "a string", "a table": what a node is, for "found ..."
 
 namespace arpipe {
 
@@ -62,35 +63,6 @@ std::string toml_place(const toml::source_region& region, const std::string& sou
 
 // The label given to the text of a `--set` override, so toml_place() names the override.
 std::string override_label(std::string_view assignment);
-
-// A check on a finite number, with the words that describe it ("[1, 4]", ">= 0").
-struct NumberRange {
-  std::function<bool(double)> ok;  // empty: every finite number
-  std::string interval;            // "[1, 4]"; empty for every number
-  std::string unit;                // "m", "degrees": shown in messages as " (m)"
-
-  static NumberRange any() { return {}; }
-  static NumberRange closed(double lo, double hi);      // [lo, hi]
-  static NumberRange open_closed(double lo, double hi);  // (lo, hi]
-  static NumberRange closed_open(double lo, double hi);  // [lo, hi)
-  static NumberRange at_least(double lo);                // >= lo
-  static NumberRange above(double lo);                   // > lo
-  // A rule of its own: interval is how messages and help texts say it.
-  static NumberRange rule(std::function<bool(double)> ok, std::string interval) { return {std::move(ok), std::move(interval), {}}; }
-  NumberRange in(std::string unit_name) const { NumberRange r = *this; r.unit = std::move(unit_name); return r; }
-
-  // "a number in [1, 4] (m)"
-  std::string phrase() const;
-};
-
-// Integer bounds, inclusive.
-struct IntRange {
-  int64_t min = std::numeric_limits<int64_t>::min();
-  int64_t max = std::numeric_limits<int64_t>::max();
-  // "[0, 30]", ">= 1", "" for any
-  std::string interval() const;
-  std::string phrase() const;  // "an integer in [0, 30]"
-};
 
 class TomlSection {
  public:

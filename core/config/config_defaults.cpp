@@ -1,0 +1,143 @@
+// `arpipe config --defaults`: the schema rows (config.h's visit functions) walked over a default
+// Config, each key printed with its default and a comment made of its rule and its help.
+#include <fmt/format.h>
+
+#include <numbers>
+
+#include "core/config/config.h"
+#include "core/config/toml_text.h"
+#include "core/track/tag_family.h"
+
+namespace arpipe {
+
+namespace {
+
+constexpr double kDegreesPerRadian = 180.0 / std::numbers::pi;
+
+std::string vec_text(const Vec3& v) {
+  return fmt::format("[{}, {}, {}]", toml_float(v[0]), toml_float(v[1]), toml_float(v[2]));
+}
+
+// "\"a\", \"b\" or \"c\""
+std::string names_text(const std::vector<std::string_view>& names) {
+  std::string out;
+  for (size_t i = 0; i < names.size(); ++i)
+    out += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + toml_quoted(names[i]);
+  return out;
+}
+
+std::string range_text(const NumberRange& range) {
+  std::string out = range.interval;
+  if (!range.unit.empty()) out += (out.empty() ? "" : " ") + fmt::format("({})", range.unit);
+  return out;
+}
+
+// The visitor that prints rows: "key = default   # rule: help".
+class RowWriter {
+ public:
+  explicit RowWriter(std::string& out) : out_(out) {}
+
+  void key(std::string_view name, bool value, std::string_view help) { row(name, value ? "true" : "false", "", help); }
+  void key(std::string_view name, const std::string& value, std::string_view help) { row(name, toml_quoted(value), "", help); }
+  void key(std::string_view name, const std::filesystem::path& value, std::string_view help) {
+    row(name, toml_quoted(value.string()), "", help);
+  }
+  void key(std::string_view name, double value, std::string_view help) { row(name, toml_float(value), "", help); }
+  void key(std::string_view name, const Vec3& value, std::string_view help) { row(name, vec_text(value), "", help); }
+  template <class Int>
+  void key(std::string_view name, Int value, const IntRange& range, std::string_view help) {
+    row(name, fmt::format("{}", value), range.interval(), help);
+  }
+  void key(std::string_view name, int value, const OneOfInts& rule, std::string_view help) {
+    std::string values;
+    for (size_t i = 0; i < rule.values.size(); ++i)
+      values += fmt::format("{}{}", i == 0 ? "" : i + 1 == rule.values.size() ? " or " : ", ", rule.values[i]);
+    row(name, fmt::format("{}", value), values, help);
+  }
+  void key(std::string_view name, double value, const NumberRange& range, std::string_view help) {
+    row(name, toml_float(value), range_text(range), help);
+  }
+  void key(std::string_view name, const Vec3& value, const NumberRange& range, std::string_view help) {
+    row(name, vec_text(value), range_text(range) + (range.interval.empty() ? "" : " each"), help);
+  }
+  void key(std::string_view name, double value_rad, const Degrees& rule, std::string_view help) {
+    row(name, toml_float(value_rad * kDegreesPerRadian), range_text(rule.range), help);
+  }
+  void key(std::string_view name, int64_t value_ns, const MillisecondsAsNs& rule, std::string_view help) {
+    row(name, toml_float(double(value_ns) * 1e-6), range_text(rule.range), help);
+  }
+  void key(std::string_view name, const std::string& value, const OneOf& rule, std::string_view help) {
+    row(name, toml_quoted(value), names_text(rule.names), help);
+  }
+  void key(std::string_view name, const std::string& value, const NotEmpty&, std::string_view help) {
+    row(name, toml_quoted(value), "", help);
+  }
+  void key(std::string_view name, const std::string& value, const TagFamilyName&, std::string_view help) {
+    row(name, toml_quoted(value), "one of " + joined_tag_family_names(), help);
+  }
+  void key(std::string_view name, const std::string& value, const CameraResponseName&, std::string_view help) {
+    row(name, toml_quoted(value), "\"srgb\", \"linear\" or \"gamma:<g>\" (0 < g)", help);
+  }
+
+  template <class Section>
+  void section(std::string_view name, Section& member, std::string_view help) {
+    RowWriter sub(out_, path(name));
+    sub.header_ = fmt::format("[{}]", sub.dotted_);
+    sub.header_help_ = help;
+    visit(sub, member);
+  }
+  template <class Element>
+  void sections(std::string_view name, std::vector<Element>& member, std::string_view help) {
+    out_ += fmt::format("\n# {}\n", help);
+    for (Element& element : member) {
+      RowWriter sub(out_, path(name));
+      out_ += fmt::format("[[{}]]\n", sub.dotted_);
+      visit(sub, element);
+    }
+  }
+
+ private:
+  RowWriter(std::string& out, std::string dotted) : out_(out), dotted_(std::move(dotted)) {}
+
+  std::string path(std::string_view name) const { return dotted_.empty() ? std::string(name) : fmt::format("{}.{}", dotted_, name); }
+
+  // The table's header goes out before its first key, so a table of tables ([sinks]) has none.
+  void flush_header() {
+    if (header_.empty()) return;
+    if (header_help_.empty())
+      out_ += fmt::format("\n{}\n", header_);
+    else
+      out_ += fmt::format("\n{:<31}# {}\n", header_ + " ", header_help_);
+    header_.clear();
+  }
+
+  void row(std::string_view name, const std::string& value, const std::string& rule, std::string_view help) {
+    flush_header();
+    const std::string assignment = fmt::format("{} = {}", name, value);
+    std::string comment = rule;
+    if (!help.empty()) comment += (comment.empty() ? "" : ": ") + std::string(help);
+    if (comment.empty())
+      out_ += assignment + "\n";
+    else
+      out_ += fmt::format("{:<32}# {}\n", assignment + " ", comment);
+  }
+
+  std::string& out_;
+  std::string dotted_;
+  std::string header_;
+  std::string_view header_help_;
+};
+
+}  // namespace
+
+std::string default_config_toml() {
+  std::string out =
+      "# arpiped configuration: every key is optional and shows its default; unknown keys are errors.\n"
+      "# Units: metres, nanoseconds, and degrees for angles (the code works in radians).\n";
+  Config defaults;
+  RowWriter writer(out);
+  visit(writer, defaults);
+  return out;
+}
+
+}  // namespace arpipe

@@ -1,0 +1,205 @@
+// Reading a config: the overrides are merged into the parsed tree, then the schema rows
+// (config.h's visit functions) are walked with a TomlSection, so the file and the command line are
+// checked alike; the checks between keys follow the rows of their table.
+#include <apriltag/apriltag.h>
+#include <fmt/format.h>
+
+#include <cmath>
+#include <numbers>
+#include <set>
+
+#include "core/config/config.h"
+#include "core/config/config_overrides.h"
+#include "core/config/text_file.h"
+#include "core/config/toml_section.h"
+#include "core/image/camera_response.h"
+#include "core/track/tag_family.h"
+
+namespace arpipe {
+
+namespace {
+
+constexpr double kRadiansPerDegree = std::numbers::pi / 180.0;
+
+std::string one_of_ints_phrase(const OneOfInts& rule) {
+  if (!rule.phrase.empty()) return rule.phrase;
+  std::string out = "one of ";
+  for (size_t i = 0; i < rule.values.size(); ++i) out += fmt::format("{}{}", i == 0 ? "" : ", ", rule.values[i]);
+  return out;
+}
+
+std::string one_of_phrase(const std::vector<std::string_view>& names) {
+  std::string out = "one of ";
+  for (size_t i = 0; i < names.size(); ++i) out += (i == 0 ? "" : ", ") + toml_quoted(names[i]);
+  return out;
+}
+
+// The camera response rule of core/image/camera_response: one rule for the config and the simulator.
+bool is_camera_response(std::string_view text) {
+  try {
+    (void)CameraResponse::parse(text, "");
+    return true;
+  } catch (const std::invalid_argument&) {
+    return false;
+  }
+}
+
+void check_cross_keys(const TomlSection& t, SourceConfig& s) {
+  if (s.reconnect_max_ms < s.reconnect_min_ms)
+    t.fail(t.has("reconnect_max_ms") ? "reconnect_max_ms" : "reconnect_min_ms",
+           fmt::format("at least reconnect_min_ms ({})", s.reconnect_min_ms), fmt::format("{}", s.reconnect_max_ms));
+}
+
+void check_cross_keys(const TomlSection& t, TrackConfig& s) {
+  if (!t.has("bundle")) return;  // the default bundle (tag 0) exists in every family
+  const int64_t code_count = create_tag_family(s.family)->ncodes;
+  const std::vector<TomlSection> tags = t.sections("bundle");
+  std::set<int> ids;
+  for (size_t i = 0; i < tags.size(); ++i) {
+    const int id = s.bundle[i].id;
+    if (id < 0 || id >= code_count)
+      tags[i].fail("id", fmt::format("an integer in [0, {}]", code_count - 1), fmt::format("{}", id));
+    if (!ids.insert(id).second) tags[i].fail("id", "an id not used by another tag of the bundle", fmt::format("{} a second time", id));
+  }
+  if (s.enabled && s.bundle.empty()) t.fail_with("bundle", "expected at least one tag while tracking is enabled");
+}
+
+void check_cross_keys(const TomlSection& t, ShadowConfig& s) {
+  if (s.vsm_blur % 2 == 0)
+    t.fail("vsm_blur", "an odd integer in [1, 31] (taps across a centred kernel)", fmt::format("{}", s.vsm_blur));
+}
+
+void check_cross_keys(const TomlSection& t, LightConfig& s) {
+  if (s.source == "environment" && s.environment.file.empty())
+    t.fail_with("source", "expected light.environment.file to be set when the source is \"environment\"");
+}
+
+void check_cross_keys(const TomlSection& t, RenderConfig& s) {
+  const double length = norm(s.light_direction);
+  if (length == 0) t.fail_with("light_direction", "expected a non-zero direction");
+  // A vector already of unit length is kept bit for bit, so printing and reading a config is exact.
+  if (std::abs(length - 1.0) > 1e-12) s.light_direction = normalized(s.light_direction);
+}
+
+template <class Section>
+void check_cross_keys(const TomlSection&, Section&) {}
+
+// The visitor that reads rows from one TomlSection; each row keeps its member when the key is absent.
+class RowReader {
+ public:
+  explicit RowReader(const TomlSection& section) : t_(section) {}
+
+  void key(std::string_view name, bool& member, std::string_view) { member = t_.boolean(name, member); }
+  void key(std::string_view name, std::string& member, std::string_view) { member = t_.string(name, member); }
+  void key(std::string_view name, std::filesystem::path& member, std::string_view) { member = t_.path(name, member); }
+  void key(std::string_view name, double& member, std::string_view) { member = t_.number(name, member); }
+  void key(std::string_view name, Vec3& member, std::string_view) { member = t_.vec3(name, member); }
+
+  void key(std::string_view name, int& member, const IntRange& range, std::string_view) {
+    member = t_.integer_as<int>(name, member, range);
+  }
+  void key(std::string_view name, int64_t& member, const IntRange& range, std::string_view) {
+    member = t_.integer(name, member, range);
+  }
+  void key(std::string_view name, int& member, const OneOfInts& rule, std::string_view) {
+    const int64_t value = t_.integer(name, member);
+    if (std::find(rule.values.begin(), rule.values.end(), value) == rule.values.end())
+      t_.fail(name, one_of_ints_phrase(rule), fmt::format("{}", value));
+    member = static_cast<int>(value);
+  }
+  void key(std::string_view name, double& member, const NumberRange& range, std::string_view) {
+    member = t_.number(name, member, range);
+  }
+  void key(std::string_view name, Vec3& member, const NumberRange& range, std::string_view) {
+    member = t_.vec3(name, member, range);
+  }
+  void key(std::string_view name, double& member_rad, const Degrees& rule, std::string_view) {
+    if (!t_.has(name)) return t_.allow(name);  // the default stays bit for bit
+    member_rad = t_.number(name, 0, rule.range) * kRadiansPerDegree;
+  }
+  void key(std::string_view name, int64_t& member_ns, const MillisecondsAsNs& rule, std::string_view) {
+    if (!t_.has(name)) return t_.allow(name);
+    const double ms = t_.number(name, 0, rule.range);
+    member_ns = std::llround(ms * 1e6);
+    if (member_ns <= 0) t_.fail(name, "at least 1 ns", toml_float(ms));
+  }
+  void key(std::string_view name, std::string& member, const OneOf& rule, std::string_view) {
+    string_satisfying(name, member, one_of_phrase(rule.names), [&](const std::string& value) {
+      return std::find(rule.names.begin(), rule.names.end(), value) != rule.names.end();
+    });
+  }
+  void key(std::string_view name, std::string& member, const NotEmpty& rule, std::string_view) {
+    string_satisfying(name, member, rule.phrase, [](const std::string& value) { return !value.empty(); });
+  }
+  void key(std::string_view name, std::string& member, const TagFamilyName&, std::string_view) {
+    string_satisfying(name, member, one_of_phrase(tag_family_names()),
+                      [](const std::string& value) { return is_tag_family(value); });
+  }
+  void key(std::string_view name, std::string& member, const CameraResponseName&, std::string_view) {
+    string_satisfying(name, member, "\"srgb\", \"linear\" or \"gamma:<g>\" with g > 0",
+                      [](const std::string& value) { return is_camera_response(value); });
+  }
+
+  template <class Section>
+  void section(std::string_view name, Section& member, std::string_view) {
+    if (const auto sub = t_.section(name)) read_section(*sub, member);
+  }
+  template <class Element>
+  void sections(std::string_view name, std::vector<Element>& member, std::string_view) {
+    if (!t_.has(name)) return t_.allow(name);
+    member.clear();
+    for (const TomlSection& sub : t_.sections(name)) {
+      Element element;
+      read_section(sub, element);
+      member.push_back(element);
+    }
+  }
+
+  template <class Section>
+  static void read_section(const TomlSection& t, Section& member) {
+    RowReader reader(t);
+    visit(reader, member);
+    check_cross_keys(t, member);
+  }
+
+ private:
+  template <class Ok>
+  void string_satisfying(std::string_view name, std::string& member, const std::string& expected, Ok ok) {
+    const toml::node* node = t_.node(name);
+    if (node == nullptr) return;
+    if (!node->is_string()) t_.fail(name, expected, std::string(toml_type_phrase(*node)));
+    const std::string& value = node->as_string()->get();
+    if (!ok(value)) t_.fail(name, expected, toml_quoted(value));
+    member = value;
+  }
+
+  const TomlSection& t_;
+};
+
+}  // namespace
+
+Config parse_config(const std::string& text, const std::string& source_name, const std::vector<std::string>& overrides) {
+  try {
+    toml::table root = parse_toml(text, source_name);
+    for (const std::string& assignment : overrides) apply_override(root, assignment);
+    Config config;
+    config.file = source_name;
+    const TomlSection file(root, source_name);
+    RowReader::read_section(file, config);
+    file.reject_stray_keys();
+    return config;
+  } catch (const TomlInputError& e) {
+    throw ConfigError(e.what());
+  }
+}
+
+Config load_config(const std::filesystem::path& path, const std::vector<std::string>& overrides) {
+  std::string why;
+  const auto text = read_text_file(path, why);
+  if (!text) throw ConfigError(fmt::format("{}: cannot read config: {}", path.string(), why));
+  Config config = parse_config(*text, path.string(), overrides);
+  config.file = path;
+  return config;
+}
+
+}  // namespace arpipe
