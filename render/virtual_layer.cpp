@@ -6,6 +6,7 @@
 
 #include "core/log.h"
 #include "render/gl/gl_error.h"
+#include "render/gl/texture_target.h"
 
 namespace arpipe {
 
@@ -28,9 +29,7 @@ void VirtualLayer::ensure(int width, int height, int msaa_samples) {
               max_samples_);
 
   resolved_texture_ = create_texel_texture(color_format_, width, height);  // the composite stage texelFetches it
-  resolved_framebuffer_ = GlFramebuffer::create();
-  glBindFramebuffer(GL_FRAMEBUFFER, resolved_framebuffer_.get());
-  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, resolved_texture_.get(), 0);
+  resolved_framebuffer_ = create_framebuffer_for(resolved_texture_.get());
   check_framebuffer_complete("virtual layer (resolved)");
 
   depth_ = GlRenderbuffer::create();
@@ -63,12 +62,7 @@ void VirtualLayer::begin(const PixelRect& rect) {
   const GLfloat transparent[4] = {0, 0, 0, 0};
   glEnable(GL_SCISSOR_TEST);
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-  if (!resolved_written_.empty() && !(resolved_written_ == rect)) {
-    glBindFramebuffer(GL_FRAMEBUFFER, resolved_framebuffer_.get());
-    glScissor(resolved_written_.x, resolved_written_.y, resolved_written_.width, resolved_written_.height);
-    glClearBufferfv(GL_COLOR, 0, transparent);
-  }
-  resolved_written_ = rect;
+  clear_written_outside(resolved_framebuffer_.get(), resolved_written_, rect);
   glBindFramebuffer(GL_FRAMEBUFFER, draw_framebuffer_.get());
   glViewport(0, 0, width_, height_);
   // GL rows are image rows (see lens_projection.h), so the rectangle needs no flip.

@@ -181,6 +181,19 @@ ImageHeader check_texture_header(const fs::path& path, const std::string& what) 
   return header;
 }
 
+// The bilinear blend, weights fx across and fy down, of the texels (x0, y0), (x1, y0), (x0, y1)
+// and (x1, y1) of a packed RGB image `width` texels wide.
+Rgb bilinear_rgb(const std::vector<float>& rgb, int width, int x0, int x1, int y0, int y1, double fx, double fy) {
+  const float* p00 = &rgb[(size_t(y0) * width + x0) * 3];
+  const float* p10 = &rgb[(size_t(y0) * width + x1) * 3];
+  const float* p01 = &rgb[(size_t(y1) * width + x0) * 3];
+  const float* p11 = &rgb[(size_t(y1) * width + x1) * 3];
+  Rgb out;
+  for (int c = 0; c < 3; ++c)
+    out[size_t(c)] = (1 - fy) * ((1 - fx) * p00[c] + fx * p10[c]) + fy * ((1 - fx) * p01[c] + fx * p11[c]);
+  return out;
+}
+
 }  // namespace
 
 PlaneTexture::PlaneTexture(const SimMaterial& material, const std::string& object_name)
@@ -261,15 +274,7 @@ Rgb PlaneTexture::reflectance(double u, double v) const {
       const double y = std::clamp(v * height_ - 0.5, 0.0, double(height_ - 1));
       const int x0 = std::min(int(x), width_ - 1), y0 = std::min(int(y), height_ - 1);
       const int x1 = std::min(x0 + 1, width_ - 1), y1 = std::min(y0 + 1, height_ - 1);
-      const double fx = x - x0, fy = y - y0;
-      const float* p00 = &rgb_[(size_t(y0) * width_ + x0) * 3];
-      const float* p10 = &rgb_[(size_t(y0) * width_ + x1) * 3];
-      const float* p01 = &rgb_[(size_t(y1) * width_ + x0) * 3];
-      const float* p11 = &rgb_[(size_t(y1) * width_ + x1) * 3];
-      Rgb out;
-      for (int c = 0; c < 3; ++c)
-        out[size_t(c)] = (1 - fy) * ((1 - fx) * p00[c] + fx * p10[c]) + fy * ((1 - fx) * p01[c] + fx * p11[c]);
-      return out;
+      return bilinear_rgb(rgb_, width_, x0, x1, y0, y1, x - x0, y - y0);
     }
   }
   return albedo_;
@@ -318,15 +323,7 @@ Rgb EnvironmentMap::radiance(const Vec3& unit_dir) const {
   if (x0 < 0) x0 += width_;
   const int x1 = x0 + 1 == width_ ? 0 : x0 + 1;
   const int y0 = std::min(int(y), height_ - 1), y1 = std::min(y0 + 1, height_ - 1);
-  const double fy = y - y0;
-  const float* p00 = &rgb_[(size_t(y0) * width_ + x0) * 3];
-  const float* p10 = &rgb_[(size_t(y0) * width_ + x1) * 3];
-  const float* p01 = &rgb_[(size_t(y1) * width_ + x0) * 3];
-  const float* p11 = &rgb_[(size_t(y1) * width_ + x1) * 3];
-  Rgb out;
-  for (int c = 0; c < 3; ++c)
-    out[size_t(c)] = (1 - fy) * ((1 - fx) * p00[c] + fx * p10[c]) + fy * ((1 - fx) * p01[c] + fx * p11[c]);
-  return out;
+  return bilinear_rgb(rgb_, width_, x0, x1, y0, y1, fx, y - y0);
 }
 
 }  // namespace arpipe::sim

@@ -6,15 +6,6 @@
 
 namespace arpipe {
 
-std::string_view motion_state_name(MotionState state) {
-  switch (state) {
-    case MotionState::None: return "none";
-    case MotionState::Interpolated: return "interpolated";
-    case MotionState::Extrapolated: return "extrapolated";
-  }
-  return "?";
-}
-
 int64_t ShutterTiming::row_start_ns(double row) const {
   if (rows <= 1 || readout_ns <= 0) return exposure_start_ns;
   const double fraction = std::clamp(row / double(rows - 1), 0.0, 1.0);

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <string_view>
 
+#include "core/config/choice_names.h"
 #include "core/frame.h"
 #include "core/geometry/se3_interpolation.h"
 
@@ -15,7 +16,13 @@ enum class MotionState {
   Interpolated,  // start and end lie between this frame's pose and its neighbours' (latency 1)
   Extrapolated,  // some of the window lies beyond the newest pose: constant velocity (latency 0)
 };
-std::string_view motion_state_name(MotionState state);
+inline constexpr ChoiceName<MotionState> kMotionStateNames[] = {{"none", MotionState::None},
+                                                                 {"interpolated", MotionState::Interpolated},
+                                                                 {"extrapolated", MotionState::Extrapolated}};
+// The state's name in the results ("none", "interpolated", "extrapolated").
+inline std::string_view motion_state_name(MotionState state) {
+  return choice_name<MotionState>(kMotionStateNames, state);
+}
 
 // The exposure window of a frame, with the simulator's row timing (docs/SIMULATOR.md): row r
 // starts exposing r/(rows-1) x readout after row 0, and every row is exposed for exposure_ns.

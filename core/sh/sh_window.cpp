@@ -5,22 +5,6 @@
 
 namespace arpipe {
 
-std::string_view sh_window_name(ShWindow window) {
-  switch (window) {
-    case ShWindow::None: return "none";
-    case ShWindow::Hanning: return "hanning";
-    case ShWindow::Lanczos: return "lanczos";
-  }
-  return "none";
-}
-
-std::optional<ShWindow> parse_sh_window(std::string_view name) {
-  if (name == "none") return ShWindow::None;
-  if (name == "hanning") return ShWindow::Hanning;
-  if (name == "lanczos") return ShWindow::Lanczos;
-  return std::nullopt;
-}
-
 double sh_window_factor(ShWindow window, int l, int bands) {
   if (l < 0 || l >= bands) return 0;
   if (l == 0) return 1;

@@ -5,15 +5,20 @@
 #include <optional>
 #include <string_view>
 
+#include "core/config/choice_names.h"
 #include "core/sh/sh_basis.h"
 
 namespace arpipe {
 
 enum class ShWindow { None, Hanning, Lanczos };
+inline constexpr ChoiceName<ShWindow> kShWindowNames[] = {
+    {"none", ShWindow::None}, {"hanning", ShWindow::Hanning}, {"lanczos", ShWindow::Lanczos}};
 
-// "none", "hanning", "lanczos"; parse returns nullopt for anything else.
-std::string_view sh_window_name(ShWindow window);
-std::optional<ShWindow> parse_sh_window(std::string_view name);
+// The window's name in kShWindowNames; parse returns nullopt for a name not in it.
+inline std::string_view sh_window_name(ShWindow window) { return choice_name<ShWindow>(kShWindowNames, window); }
+inline std::optional<ShWindow> parse_sh_window(std::string_view name) {
+  return choice_value<ShWindow>(kShWindowNames, name);
+}
 
 // h_l for a vector of `bands` bands, with the window width w = bands (so the window's first zero
 // is at l = bands, one past the highest band used: no used band is zeroed):

@@ -91,9 +91,7 @@ void IntraframeWarpBlurPass::run(GLuint first, GLuint second, int width, int hei
     throw RenderError(fmt::format("seed blur pass: image size {}x{}", width, height));
   if (width != width_ || height != height_ || !output_texture_) {
     output_texture_ = create_texel_texture(output_format_, width, height);
-    output_framebuffer_ = GlFramebuffer::create();
-    glBindFramebuffer(GL_FRAMEBUFFER, output_framebuffer_.get());
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, output_texture_.get(), 0);
+    output_framebuffer_ = create_framebuffer_for(output_texture_.get());
     check_framebuffer_complete("seed blur output");
     width_ = width, height_ = height;
   }

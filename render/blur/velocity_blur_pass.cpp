@@ -172,9 +172,7 @@ void VelocityBlurPass::ensure_targets(int width, int height) {
   const auto make_target = [](GLenum format, int w, int h, GlTexture& texture, GlFramebuffer& framebuffer,
                               const char* what) {
     texture = create_texel_texture(format, w, h);
-    framebuffer = GlFramebuffer::create();
-    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer.get());
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture.get(), 0);
+    framebuffer = create_framebuffer_for(texture.get());
     check_framebuffer_complete(what);
   };
   make_target(GL_RG16F, tiles_x_, tiles_y_, tile_max_texture_, tile_max_framebuffer_, "velocity blur tile max");

@@ -57,4 +57,12 @@ inline GlTexture create_texel_texture(GLenum internal_format, int width, int hei
   return texture;
 }
 
+// A framebuffer whose colour attachment 0 is level 0 of `texture`. Leaves it bound.
+inline GlFramebuffer create_framebuffer_for(GLuint texture) {
+  GlFramebuffer framebuffer = GlFramebuffer::create();
+  glBindFramebuffer(GL_FRAMEBUFFER, framebuffer.get());
+  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture, 0);
+  return framebuffer;
+}
+
 }  // namespace arpipe

@@ -12,23 +12,20 @@
 namespace arpipe {
 namespace {
 
-std::string shader_log(GLuint shader) {
+// The info log of a shader or a program (glGetShaderiv and glGetShaderInfoLog, or the program
+// ones), without its terminating NUL.
+template <class GetIv, class GetInfoLog>
+std::string info_log(GLuint object, GetIv get_iv, GetInfoLog get_info_log) {
   GLint length = 0;
-  glGetShaderiv(shader, GL_INFO_LOG_LENGTH, &length);
+  get_iv(object, GL_INFO_LOG_LENGTH, &length);
   std::string log(static_cast<size_t>(std::max(length, 1)), '\0');
-  glGetShaderInfoLog(shader, length, nullptr, log.data());
+  get_info_log(object, length, nullptr, log.data());
   log.resize(log.find('\0') == std::string::npos ? log.size() : log.find('\0'));
   return log;
 }
 
-std::string program_log(GLuint program) {
-  GLint length = 0;
-  glGetProgramiv(program, GL_INFO_LOG_LENGTH, &length);
-  std::string log(static_cast<size_t>(std::max(length, 1)), '\0');
-  glGetProgramInfoLog(program, length, nullptr, log.data());
-  log.resize(log.find('\0') == std::string::npos ? log.size() : log.find('\0'));
-  return log;
-}
+std::string shader_log(GLuint shader) { return info_log(shader, glGetShaderiv, glGetShaderInfoLog); }
+std::string program_log(GLuint program) { return info_log(program, glGetProgramiv, glGetProgramInfoLog); }
 
 GLuint compile(GLenum type, std::string_view source, const std::string& program_name) {
   const char* stage = type == GL_VERTEX_SHADER ? "vertex" : "fragment";

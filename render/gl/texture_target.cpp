@@ -8,9 +8,7 @@ namespace arpipe {
 void TextureTarget::ensure(GLenum color_format, int width, int height, bool with_depth) {
   if (texture_ && color_format == format_ && width == width_ && height == height_ && with_depth == with_depth_) return;
   texture_ = create_texel_texture(color_format, width, height);
-  framebuffer_ = GlFramebuffer::create();
-  glBindFramebuffer(GL_FRAMEBUFFER, framebuffer_.get());
-  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture_.get(), 0);
+  framebuffer_ = create_framebuffer_for(texture_.get());
   depth_.reset();
   if (with_depth) {
     depth_ = GlRenderbuffer::create();
@@ -28,19 +26,19 @@ void TextureTarget::ensure(GLenum color_format, int width, int height, bool with
   written_ = PixelRect::full(width, height);
 }
 
-void TextureTarget::clear_outside(const PixelRect& keep) {
-  // The old rectangle and the new one usually overlap; clearing the old one whole is simpler than
-  // its difference and costs about the same.
-  if (!written_.empty() && !(written_ == keep)) {
-    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer_.get());
+void clear_written_outside(GLuint framebuffer, PixelRect& written, const PixelRect& keep) {
+  if (!written.empty() && !(written == keep)) {
+    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
     glEnable(GL_SCISSOR_TEST);
-    glScissor(written_.x, written_.y, written_.width, written_.height);
+    glScissor(written.x, written.y, written.width, written.height);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     const GLfloat transparent[4] = {0, 0, 0, 0};
     glClearBufferfv(GL_COLOR, 0, transparent);
   }
-  written_ = keep;
+  written = keep;
 }
+
+void TextureTarget::clear_outside(const PixelRect& keep) { clear_written_outside(framebuffer_.get(), written_, keep); }
 
 void TextureTarget::begin(const PixelRect& rect) {
   clear_outside(rect);

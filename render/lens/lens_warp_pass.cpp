@@ -65,9 +65,7 @@ void LensWarpPass::set_map(std::shared_ptr<const LensWarpMap> map) {
   glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
   glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width, height, GL_RG, GL_FLOAT, map->canvas_xy().data());
   output_texture_ = create_texel_texture(output_format_, width, height);  // the composite stage texelFetches it
-  output_framebuffer_ = GlFramebuffer::create();
-  glBindFramebuffer(GL_FRAMEBUFFER, output_framebuffer_.get());
-  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, output_texture_.get(), 0);
+  output_framebuffer_ = create_framebuffer_for(output_texture_.get());
   check_framebuffer_complete("lens warp output");
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   check_gl("uploading the lens warp map");
