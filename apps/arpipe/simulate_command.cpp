@@ -88,7 +88,8 @@ void add_simulate_command(CLI::App& arpipe) {
         } catch (const std::exception&) {
           return false;
         }
-      }, "a square number"));
+      }, "a square number"))
+      ->default_str("the scene's");
   cli::on_run(command, [options] { return run_simulate(*options); });
 }
 

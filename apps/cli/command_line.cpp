@@ -71,11 +71,11 @@ int parse_and_run(CLI::App& app, int argc, char** argv) {
   try {
     app.parse(argc, argv);
     return 0;
-  } catch (const CLI::ParseError& e) {
+  } catch (const CLI::RuntimeError& e) {
+    return e.get_exit_code();  // a command's own exit status (on_run)
+  } catch (const CLI::Error& e) {
     // --help and --version are "errors" with status 0; every other one is a usage error.
     return app.exit(e) == 0 ? 0 : 2;
-  } catch (const CLI::Error& e) {
-    return app.exit(e);  // a command's own exit status (on_run)
   }
 }
 
