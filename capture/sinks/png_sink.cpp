@@ -14,7 +14,7 @@
 namespace arpipe {
 
 PngSink::PngSink(const PngSinkConfig& config)
-    : dir_(config.dir), every_(std::max(1, config.every)), outage_(dir_.string(), "no partial PNG is left behind") {
+    : dir_(config.dir), every_(std::max(1, config.every)), compression_(config.compression), outage_(dir_.string(), "no partial PNG is left behind") {
   create_output_directory(dir_, "sinks.png.dir");
   remove_stale_temporaries(dir_, [](std::string_view target) { return target.starts_with("frame_"); });
 }
@@ -39,7 +39,11 @@ void PngSink::consume(const FrameContext& ctx) noexcept {
     // Encoded in memory: libpng never meets a failing file (and prints nothing), and the file is
     // written whole or not at all.
     std::vector<uint8_t> png;
-    if (!cv::imencode(".png", bgr, png)) throw std::runtime_error("the PNG encoder refused the frame");
+    // Level 1 is OpenCV's default, which also picks its fast filter and strategy: naming the level
+    // would switch those, so the default stays unnamed and its PNGs keep their bytes.
+    std::vector<int> params;
+    if (compression_ != 1) params = {cv::IMWRITE_PNG_COMPRESSION, compression_};
+    if (!cv::imencode(".png", bgr, png, params)) throw std::runtime_error("the PNG encoder refused the frame");
     if (const int error = replace_file(path, png))
       why = fmt::format("{}: {}", path.string(), std::strerror(error));
   } catch (const std::exception& e) {

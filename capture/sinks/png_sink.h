@@ -23,6 +23,7 @@ class PngSink : public FrameSink {
  private:
   std::filesystem::path dir_;
   int every_;
+  int compression_;  // sinks.png.compression
   WriteOutage outage_;
 };
 

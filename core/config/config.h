@@ -485,6 +485,7 @@ struct PngSinkConfig {
   bool enabled = true;
   std::filesystem::path dir = "out/png";
   int every = 1;  // write every Nth frame
+  int compression = 1;  // OpenCV's own default level (capture/sinks/png_sink.cpp)
 
   bool operator==(const PngSinkConfig&) const = default;
 };
@@ -496,6 +497,8 @@ void visit(V& v, PngSinkConfig& s) {
   v.key("enabled", s.enabled, "write PNG frames");
   v.key("dir", s.dir, "the directory the frames go to");
   v.key("every", s.every, IntRange{1}, "write every Nth frame");
+  v.key("compression", s.compression, IntRange{0, 9}, "zlib level; 1: OpenCV's fast default (SUB filter, RLE); other levels use zlib's default strategy, "
+        "not always smaller on camera noise");
 }
 struct Y4mSinkConfig {
   bool enabled = true;
