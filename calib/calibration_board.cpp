@@ -54,7 +54,8 @@ std::pair<int, int> grid(const TomlSection& s, std::string_view key, std::string
     const std::string item = fmt::format("{}[{}]", s.key_path(key), i);
     if (!array[i].is_integer()) s.fail_at(array[i], item, range.phrase(), std::string(toml_type_phrase(array[i])));
     values[i] = array[i].as_integer()->get();
-    if (values[i] < range.min || values[i] > range.max) s.fail_at(array[i], item, range.phrase(), fmt::format("{}", values[i]));
+    if (values[i] < range.min || values[i] > range.max)
+      s.fail_at(array[i], item, range.phrase(), fmt::format("{}", values[i]));
   }
   if (values[0] * values[1] > kMaxGridPoints)
     s.fail(key, fmt::format("at most {} points", kMaxGridPoints), fmt::format("{} x {}", values[0], values[1]));

@@ -89,7 +89,8 @@ int64_t milliseconds(const TomlSection& s, std::string_view k, int64_t fallback_
     return fallback_ns;
   }
   const double ms = s.number(k, 0, range);
-  if (std::abs(ms) > kMaxAbsMs) s.fail(k, fmt::format("{}, within +-{:g} ms", range.phrase(), kMaxAbsMs), fmt::format("{}", ms));
+  if (std::abs(ms) > kMaxAbsMs)
+    s.fail(k, fmt::format("{}, within +-{:g} ms", range.phrase(), kMaxAbsMs), fmt::format("{}", ms));
   return ms_to_ns(ms);
 }
 
@@ -150,7 +151,7 @@ CameraModel read_camera_model(const TomlSection& s) {
       return CameraModel::load(path);
     } catch (const CameraModelError& e) {
       s.fail_with("model", fmt::format("expected a valid mrcal .cameramodel file, found one that is not ({}): {}",
-                                  path.string(), e.what()));
+                                       path.string(), e.what()));
     }
   }
   const int width = s.integer_as<int>("width", 640, IntRange{1, 65535});
@@ -166,7 +167,7 @@ CameraModel read_camera_model(const TomlSection& s) {
   } catch (const CameraModelError& e) {
     const bool bad_name = std::string_view(e.what()).find("unknown lens model") != std::string_view::npos;
     s.fail_with(bad_name || !s.has("intrinsics") ? "lensmodel" : "intrinsics",
-           fmt::format("expected a valid mrcal lens model and intrinsics, found: {}", e.what()));
+                fmt::format("expected a valid mrcal lens model and intrinsics, found: {}", e.what()));
   }
 }
 
@@ -190,14 +191,14 @@ SimCamera read_camera(const TomlSection& s) {
   if (const auto problem = check_image_size(camera.pixel_format, camera.model.width(), camera.model.height())) {
     const std::string_view k = s.has("pixel_format") ? "pixel_format" : s.has("model") ? "model" : "width";
     s.fail_with(k, fmt::format("expected an image size that {} can hold, found {}x{}: {}", format, camera.model.width(),
-                          camera.model.height(), *problem));
+                               camera.model.height(), *problem));
   }
   if (camera.model.width() > kMaxFrameSide || camera.model.height() > kMaxFrameSide ||
       int64_t{camera.model.width()} * camera.model.height() > kMaxFramePixels) {
     const std::string_view k = s.has("model") ? "model" : camera.model.width() > kMaxFrameSide || !s.has("height") ? "width" : "height";
     s.fail_with(k, fmt::format("expected a simulated frame of at most {} pixels a side and {} pixels in all (rendering "
-                          "holds about 80 bytes a pixel), found {}x{}",
-                          kMaxFrameSide, kMaxFramePixels, camera.model.width(), camera.model.height()));
+                               "holds about 80 bytes a pixel), found {}x{}",
+                               kMaxFrameSide, kMaxFramePixels, camera.model.width(), camera.model.height()));
   }
 
   camera.fps =
@@ -366,10 +367,9 @@ void read_texture(const TomlSection& object, const TomlSection& s, SimObject& ou
   t.kind = s.choice("kind", SimTexture::Kind::None, kSimTextureKindNames);
   const std::string_view kind = choice_name<SimTexture::Kind>(kSimTextureKindNames, t.kind);
   if (out.material.kind == SimMaterial::Kind::Mirror)
-    s.fail_with("kind",
-           fmt::format(
-               "expected no texture on a mirror (only Lambertian materials have one), found a {} texture on a mirror",
-               kind));
+    s.fail_with("kind", fmt::format("expected no texture on a mirror (only Lambertian materials have one), found a {} "
+                                    "texture on a mirror",
+                                    kind));
   const auto only = [&](const std::vector<std::string_view>& keys, std::string_view which) {
     for (const auto k : keys) forbid(s, k, fmt::format("it applies to {} textures only", which));
   };
@@ -387,14 +387,14 @@ void read_texture(const TomlSection& object, const TomlSection& s, SimObject& ou
     }
     if (header.width > kMaxTextureSide || header.height > kMaxTextureSide ||
         header.width * header.height > kMaxTexturePixels)
-      s.fail_with("image", fmt::format("expected an image of at most {} pixels a side and {} pixels in all, found \"{}\": "
-                                  "{} x {} {}",
-                                  kMaxTextureSide, kMaxTexturePixels, t.image_path.string(), header.width,
-                                  header.height, header.format));
+      s.fail_with("image", fmt::format("expected an image of at most {} pixels a side and {} pixels in all, "
+                                       "found \"{}\": {} x {} {}",
+                                       kMaxTextureSide, kMaxTexturePixels, t.image_path.string(), header.width,
+                                       header.height, header.format));
     if (!cv::haveImageReader(t.image_path.string()))
       s.fail_with("image",
                   fmt::format("expected an image file OpenCV can decode (PNG or JPEG), found \"{}\", which is not one",
-                         t.image_path.string()));
+                              t.image_path.string()));
     return;
   }
   forbid(s, "image", "it applies to image textures only");
@@ -473,7 +473,7 @@ SimObject read_object(const TomlSection& s, size_t index) {
         load_gltf_mesh(out.mesh_path);  // the simulator loads it again; this makes a bad file a scene error
       } catch (const AssetError& e) {
         s.fail_with("mesh", fmt::format("expected a valid glTF 2.0 file, found one that is not ({}): {}",
-                                   out.mesh_path.string(), e.what()));
+                                        out.mesh_path.string(), e.what()));
       }
     }
     out.mesh_scale = s.number("mesh_scale", out.mesh_scale, kPositive);
@@ -542,7 +542,7 @@ SimEnvironment read_environment(const TomlSection& s) {
     in.read(magic, 2);
     if (magic[0] != '#' || magic[1] != '?')
       s.fail_with("hdr", fmt::format("expected a Radiance .hdr image (starting \"#?\"), found \"{}\", which is not one",
-                                out.hdr_path.string()));
+                                     out.hdr_path.string()));
     out.radiance = {1, 1, 1};  // with an image, radiance is its multiplier
   }
   out.radiance = s.vec3("radiance", out.radiance, kNonNegative);

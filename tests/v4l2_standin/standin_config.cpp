@@ -28,7 +28,8 @@ std::string table_place(const TomlSection& s) { return toml_place(s.table().sour
 std::vector<OfferedFormatName> read_formats(const TomlSection& s, std::vector<OfferedFormatName> fallback) {
   const toml::node* n = s.node("formats");
   if (n == nullptr) return fallback;
-  const std::string expected = "an array of formats, each one of " + choice_list<OfferedFormatName>(kOfferedFormatNames);
+  const std::string expected =
+      "an array of formats, each one of " + choice_list<OfferedFormatName>(kOfferedFormatNames);
   if (!n->is_array()) s.fail("formats", expected, std::string(toml_type_phrase(*n)));
   if (n->as_array()->empty()) s.fail("formats", expected, "an empty array");
   std::vector<OfferedFormatName> out;
@@ -53,8 +54,8 @@ Fault read_fault(const TomlSection& s) {
   // Keys that mean nothing for this kind are errors, so a typo'd plan does not silently do less.
   const auto only_for = [&](std::string_view key, FaultKind owner) {
     if (s.has(key) && f.kind != owner)
-      s.fail_with(key, fmt::format("applies only to kind \"{}\", not \"{}\"", choice_name<FaultKind>(kFaultKindNames, owner),
-                                   kind));
+      s.fail_with(key, fmt::format("applies only to kind \"{}\", not \"{}\"",
+                                   choice_name<FaultKind>(kFaultKindNames, owner), kind));
   };
   only_for("replug_after_ms", FaultKind::Unplug);
   only_for("duration_ms", FaultKind::Stall);
