@@ -111,10 +111,10 @@ void add_calib_command(CLI::App& arpipe) {
   CLI::Option* recording = command->add_option("--recording", options->recording, "a recording's frames")
                                ->type_name("DIR");
   images->excludes(recording);
-  command->add_option("--board", options->board_path, "the board file (configs/boards/*.toml)")
-      ->type_name("FILE")
-      ->required();
-  command->add_option("--out", options->out, "the camera model to write")->type_name("CAMERA.cameramodel")->required();
+  // Required, like one of --images and --recording: checked together below, one message for all.
+  command->add_option("--board", options->board_path, "the board file (configs/boards/*.toml); required")
+      ->type_name("FILE");
+  command->add_option("--out", options->out, "the camera model to write; required")->type_name("CAMERA.cameramodel");
   command->add_option("--lensmodel", options->solve.lensmodel,
                       "OPENCV8, OPENCV4, OPENCV5, PINHOLE, SPLINED_STEREOGRAPHIC (configured automatically) or a full "
                       "mrcal name; the LENSMODEL_ prefix is optional")
@@ -127,7 +127,8 @@ void add_calib_command(CLI::App& arpipe) {
   command->add_flag_function("--no-warp", [options](int64_t) { options->solve.optimize_board_warp = false; },
                              "do not solve for the board's warp");
   cli::on_run(command, [options, images, recording] {
-    if (!*images && !*recording) cli::usage_error("give one of --images and --recording");
+    if ((!*images && !*recording) || options->board_path.empty() || options->out.empty())
+      cli::usage_error("give one of --images and --recording, and --board and --out");
     return calibrate(*options);
   });
 }
