@@ -83,12 +83,7 @@ void CompositeStage::configure(const Config& config) {
   }
   // The virtual layer is linear light: it goes out through the same response the camera's pixels
   // came in by, so virtual and real brighten and darken together.
-  CameraResponse response;
-  try {
-    response = CameraResponse::parse(config.light.response, "light.response");
-  } catch (const std::exception& e) {
-    throw ConfigError(fmt::format("{}: {}", config.file.string(), e.what()));
-  }
+  const CameraResponse& response = config.light.response;  // parsed when the config was loaded
   glUseProgram(program_.id());
   glUniform1i(program_.uniform("u_response"), response.kind() == CameraResponse::Kind::Linear  ? 1
                                                : response.kind() == CameraResponse::Kind::Gamma ? 2

@@ -10,6 +10,7 @@
 
 #include "core/config/config_rules.h"
 #include "core/geometry/vec.h"
+#include "core/image/camera_response.h"
 
 namespace arpipe {
 
@@ -454,7 +455,7 @@ struct LightConfig {
   // "probe": a light probe sphere in view ([light.probe]); "sun": place and time ([light.sun]);
   // "environment": an HDR light probe file ([light.environment]).
   std::string source = "fixed";
-  std::string response = "srgb";         // the camera's response curve: "srgb", "linear" or "gamma:<g>"
+  CameraResponse response;               // sRGB
   double smoothing_s = 0.3;              // time constant of the temporal smoothing, [0, 60]
   // The real ground around the anchor, whose brightness gives the light's strength where nothing
   // else can: the sun always, and a probe whose brightest light is clipped.

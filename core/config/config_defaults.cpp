@@ -75,8 +75,8 @@ class RowWriter {
   void key(std::string_view name, const std::string& value, const TagFamilyName&, std::string_view help) {
     row(name, toml_quoted(value), "one of " + joined_tag_family_names(), help);
   }
-  void key(std::string_view name, const std::string& value, const CameraResponseName&, std::string_view help) {
-    row(name, toml_quoted(value), "\"srgb\", \"linear\" or \"gamma:<g>\" (0 < g)", help);
+  void key(std::string_view name, const CameraResponse& value, const CameraResponseName&, std::string_view help) {
+    row(name, toml_quoted(value.name()), "\"srgb\", \"linear\" or \"gamma:<g>\" (0 < g)", help);
   }
 
   template <class Section>

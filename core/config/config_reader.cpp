@@ -34,16 +34,6 @@ std::string one_of_phrase(const std::vector<std::string_view>& names) {
   return out;
 }
 
-// The camera response rule of core/image/camera_response: one rule for the config and the simulator.
-bool is_camera_response(std::string_view text) {
-  try {
-    (void)CameraResponse::parse(text, "");
-    return true;
-  } catch (const std::invalid_argument&) {
-    return false;
-  }
-}
-
 void check_cross_keys(const TomlSection& t, SourceConfig& s) {
   if (s.reconnect_max_ms < s.reconnect_min_ms)
     t.fail(t.has("reconnect_max_ms") ? "reconnect_max_ms" : "reconnect_min_ms",
@@ -135,9 +125,10 @@ class RowReader {
     string_satisfying(name, member, one_of_phrase(tag_family_names()),
                       [](const std::string& value) { return is_tag_family(value); });
   }
-  void key(std::string_view name, std::string& member, const CameraResponseName&, std::string_view) {
-    string_satisfying(name, member, "\"srgb\", \"linear\" or \"gamma:<g>\" with g > 0",
-                      [](const std::string& value) { return is_camera_response(value); });
+  // Parsed once here by core/image/camera_response's own rule, the one the simulator uses too.
+  void key(std::string_view name, CameraResponse& member, const CameraResponseName&, std::string_view) {
+    member = t_.parsed<CameraResponse>(name, member, CameraResponse::from_name,
+                                       "\"srgb\", \"linear\" or \"gamma:<g>\" with g > 0");
   }
 
   template <class Section>

@@ -28,6 +28,14 @@ CameraResponse CameraResponse::gamma(double g) {
   return r;
 }
 
+std::optional<CameraResponse> CameraResponse::from_name(std::string_view text) {
+  try {
+    return parse(text, "");
+  } catch (const std::invalid_argument&) {
+    return std::nullopt;
+  }
+}
+
 CameraResponse CameraResponse::parse(std::string_view text, std::string_view where) {
   if (text == "srgb") return srgb();
   if (text == "linear") return linear();

@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -27,6 +28,8 @@ class CameraResponse {
   // "srgb", "linear" or "gamma:<g>" (the simulator's camera.sensor.response words). Throws
   // std::invalid_argument naming `where` and the text when it is none of these.
   static CameraResponse parse(std::string_view text, std::string_view where);
+  // The same rule without the message: nullopt when the text is none of these (the config's reader).
+  static std::optional<CameraResponse> from_name(std::string_view text);
 
   Kind kind() const { return kind_; }
   double gamma_value() const { return gamma_; }
@@ -38,6 +41,8 @@ class CameraResponse {
   float decode8(uint8_t value) const { return lut_[value]; }
   const std::array<float, 256>& lut() const { return lut_; }
   static bool clipped(uint8_t value) { return value >= kClippedFrom; }
+
+  bool operator==(const CameraResponse&) const = default;
 
  private:
   void build_lut();

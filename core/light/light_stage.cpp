@@ -42,12 +42,7 @@ void LightStage::configure_loaded(const Config& config, const std::shared_ptr<co
   const auto* loaded = dynamic_cast<const EnvironmentAssets*>(assets.get());
   if (!loaded) throw std::logic_error("LightStage::configure_loaded: no assets from the light stage's loader");
   const LightConfig& light = config.light;
-  CameraResponse response;
-  try {
-    response = CameraResponse::parse(light.response, "light.response");
-  } catch (const std::exception& e) {
-    throw ConfigError(fmt::format("{}: {}", config.file.string(), e.what()));
-  }
+  const CameraResponse& response = light.response;  // parsed when the config was loaded
   std::unique_ptr<ProbeLightEstimator> probe;
   std::unique_ptr<SunLight> sun;
   LightEstimate environment;

@@ -508,3 +508,22 @@ TEST(Config, EnvironmentAndPrtValuesOutOfRangeAreRefusedNamingFileAndKey) {
 
 }  // namespace
 }  // namespace arpipe
+
+namespace arpipe {
+namespace {
+
+TEST(Config, LightResponseIsParsedOnceByTheCameraResponseRule) {
+  EXPECT_EQ(Config{}.light.response, CameraResponse::srgb());
+  EXPECT_EQ(parse_config("[light]\nresponse = \"linear\"\n", "r.toml").light.response, CameraResponse::linear());
+  const CameraResponse g = parse_config("[light]\nresponse = \"gamma:2.2\"\n", "r.toml").light.response;
+  EXPECT_EQ(g.kind(), CameraResponse::Kind::Gamma);
+  EXPECT_EQ(g.gamma_value(), 2.2);
+  expect_error("[light]\nresponse = \"gamma:0\"\n",
+               {"test.toml:2:12:", "light.response: expected \"srgb\", \"linear\" or \"gamma:<g>\" with g > 0", "found \"gamma:0\""});
+  expect_error("[light]\nresponse = \"log\"\n", {"light.response: expected", "found \"log\""});
+  // --defaults prints the typed value by its name, and reads back as the same value.
+  EXPECT_NE(default_config_toml().find("\nresponse = \"srgb\""), std::string::npos);
+}
+
+}  // namespace
+}  // namespace arpipe
