@@ -20,8 +20,8 @@ packages=(
   # render: EGL + GLES 3 on Mesa (llvmpipe when there is no GPU)
   libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri libgbm1
   libtinygltf-dev libembree-dev libstb-dev libpng-dev
-  # tests and benchmarks
-  libgtest-dev libgmock-dev librapidcheck-dev libbenchmark-dev
+  # tests
+  libgtest-dev libgmock-dev librapidcheck-dev
   # mrcal's own tools: tests check our camera model against them
   mrcal python3-mrcal
   # checking the Y4M output plays
