@@ -1,6 +1,6 @@
 // Seed 000's motion-blur schedule (Park, Lepetit and Woo 2012, as the thesis adapts it): how many
 // samples, when each lies in the exposure, and the affine warps that make each from the two
-// rendered intraframes at 1/4 and 3/4 of the exposure. CPU only; render/seed_blur_pass draws it.
+// rendered intraframes at 1/4 and 3/4 of the exposure. CPU only; render/blur/intraframe_warp_blur_pass draws it.
 #pragma once
 
 #include <functional>

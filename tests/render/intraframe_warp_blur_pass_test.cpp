@@ -271,7 +271,7 @@ TEST_F(SeedBlurPassTest, CostAt640x480) {
     std::sort(ms.begin(), ms.end());
     std::cout << "seed blur pass, 640x480, rect 200x200, " << count << " samples, " << context().gl_renderer()
               << ": median " << ms[ms.size() / 2] << " ms, min " << ms.front() << " ms\n";
-    RecordProperty("seed_blur_median_ms_" + std::to_string(count), std::to_string(ms[ms.size() / 2]));
+    RecordProperty("intraframe_warp_blur_median_ms_" + std::to_string(count), std::to_string(ms[ms.size() / 2]));
   }
   EXPECT_EQ(glGetError(), GLenum(GL_NO_ERROR));
 }
