@@ -72,7 +72,7 @@ CompositeStage::~CompositeStage() {
 }
 
 void CompositeStage::configure(const Config& config) {
-  const LensMode lens = parse_lens_mode(config.render.lens);
+  const LensMode lens = config.render.lens;
   session_->make_current();
   if (program_.id() == 0) {
     program_ = GlProgram("compositing", kFullScreenTriangleVertexShader, kFragmentShader);

@@ -79,7 +79,7 @@ void RenderStage::configure_loaded(const Config& config, const std::shared_ptr<c
   settings.light_distance_m = config.render.light_distance_m;
   settings.light_color = config.render.light_color;
   settings.ambient = config.render.ambient;
-  settings.lens = parse_lens_mode(config.render.lens);
+  settings.lens = config.render.lens;
   settings.lens_canvas_scale = config.render.lens_canvas_scale;
   settings.rolling_shutter = config.render.rolling_shutter;
   settings.max_predicted_uncertainty_deg = config.render.max_predicted_uncertainty_deg;

@@ -67,7 +67,7 @@ std::unique_ptr<PipelineRunner> assemble_pipeline(const Config& config) {
   auto source = make_source(config);
   // A lens the renderer cannot reproduce in the configured render.lens mode is a setup error,
   // refused before streaming starts. "undistort" changes the output even without objects.
-  const LensMode lens = parse_lens_mode(config.render.lens);
+  const LensMode lens = config.render.lens;
   const bool renders = config.render.enabled && !config.render.objects.empty();
   // Tracking and rendering project through the camera's model: without one nothing would land
   // where it belongs. (A model of another image size is refused by the source that loads it.)

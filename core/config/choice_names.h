@@ -41,6 +41,16 @@ std::optional<E> choice_value(ChoiceNames<E> names, std::string_view text) {
   return std::nullopt;
 }
 
+// The same for a name table given as an array (kLensModeNames).
+template <class E, size_t N>
+std::string_view choice_name(const ChoiceName<E> (&names)[N], E value) {
+  return choice_name(ChoiceNames<E>(names), value);
+}
+template <class E, size_t N>
+std::optional<E> choice_value(const ChoiceName<E> (&names)[N], std::string_view text) {
+  return choice_value(ChoiceNames<E>(names), text);
+}
+
 // "\"a\", \"b\", \"c\"": the names to offer (aliases not shown).
 template <class E>
 std::string choice_list(ChoiceNames<E> names) {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/config/config_rules.h"
+#include "core/config/lens_mode.h"
 #include "core/geometry/vec.h"
 #include "core/image/camera_response.h"
 
@@ -304,14 +305,7 @@ struct RenderConfig {
   Vec3 ambient{0.25, 0.25, 0.25};        // linear
   int msaa_samples = 4;
   std::string egl_platform = "auto";     // "auto", "surfaceless", "device"
-  // How the virtual layer matches the real lens (docs/ARCHITECTURE.md, "Lens-matched rendering"):
-  // "map": draw with the lens model's pinhole core on an enlarged canvas, then warp it through a
-  //   per-pixel map built once with mrcal (any lens mrcal can unproject, up to 75 degrees off axis);
-  // "vertex": distort per vertex in the vertex shader (PINHOLE and OPENCV4/5/8 only; edges between
-  //   vertices stay straight);
-  // "undistort": warp the camera frame to the pinhole core and draw pinhole: the output is an
-  //   undistorted picture, whose camera model is the pinhole core.
-  std::string lens = "map";
+  LensMode lens = LensMode::Map;
   // "map" only: canvas pixels per pinhole-core pixel, in [1, 4]. 4x multisampling alone leaves a
   // straight edge up to 1/8 canvas pixel off; a finer canvas divides that, at its square in fill
   // and memory (tests/render/lens_matched_rendering_test.cpp measures both).
@@ -341,7 +335,7 @@ void visit(V& v, RenderConfig& s) {
   v.key("ambient", s.ambient, NumberRange::at_least(0), "linear RGB");
   v.key("msaa_samples", s.msaa_samples, OneOfInts{{0, 1, 2, 4}, ""}, "multisampling");
   v.key("egl_platform", s.egl_platform, OneOf{{"auto", "surfaceless", "device"}}, "EGL platform");
-  v.key("lens", s.lens, OneOf{{"map", "vertex", "undistort"}},
+  v.key("lens", s.lens, kLensModeNames,
         "how the virtual layer matches the real lens: map: draw pinhole on an enlarged canvas, warp through a "
         "per-pixel map (any lens mrcal can unproject); vertex: distort per vertex (PINHOLE, OPENCV4/5/8); "
         "undistort: undistort the camera frame to the pinhole core and draw pinhole");

@@ -79,6 +79,14 @@ class RowWriter {
     row(name, toml_quoted(value.name()), "\"srgb\", \"linear\" or \"gamma:<g>\" (0 < g)", help);
   }
 
+  template <class E, size_t N>
+  void key(std::string_view name, E value, const ChoiceName<E> (&names)[N], std::string_view help) {
+    std::vector<std::string_view> shown;
+    for (const auto& entry : names)
+      if (!entry.alias) shown.push_back(entry.name);
+    row(name, toml_quoted(choice_name(names, value)), names_text(shown) + choice_aliases(ChoiceNames<E>(names)), help);
+  }
+
   template <class Section>
   void section(std::string_view name, Section& member, std::string_view help) {
     RowWriter sub(out_, path(name));

@@ -131,6 +131,12 @@ class RowReader {
                                        "\"srgb\", \"linear\" or \"gamma:<g>\" with g > 0");
   }
 
+  // A choice: its name table's names and aliases.
+  template <class E, size_t N>
+  void key(std::string_view name, E& member, const ChoiceName<E> (&names)[N], std::string_view) {
+    member = t_.choice(name, member, names);
+  }
+
   template <class Section>
   void section(std::string_view name, Section& member, std::string_view) {
     if (const auto sub = t_.section(name)) read_section(*sub, member);

@@ -11,22 +11,6 @@
 
 namespace arpipe {
 
-LensMode parse_lens_mode(std::string_view name) {
-  if (name == "map") return LensMode::Map;
-  if (name == "vertex") return LensMode::Vertex;
-  if (name == "undistort") return LensMode::Undistort;
-  throw ConfigError(fmt::format("render.lens: expected \"map\", \"vertex\" or \"undistort\", got \"{}\"", name));
-}
-
-std::string_view lens_mode_name(LensMode mode) {
-  switch (mode) {
-    case LensMode::Map: return "map";
-    case LensMode::Vertex: return "vertex";
-    case LensMode::Undistort: return "undistort";
-  }
-  return "unknown";
-}
-
 void check_lens_for_mode(const CameraModel& model, LensMode mode) {
   switch (mode) {
     case LensMode::Map: check_lens_warpable(model); return;

@@ -143,7 +143,7 @@ TEST(RenderStages, PinholeCoverageWithMsaa) {
 
 CoverageCounts opencv8_coverage(const std::string& lens, double band) {
   Config config = cube_config(4);
-  config.render.lens = lens;
+  config.render.lens = *choice_value(kLensModeNames, lens);
   harness().configure(config);
   const Frame background = varied_background(kWidth, kHeight);
   // Off to the side of the image, where the lens bends the cube's edges most.
@@ -192,7 +192,7 @@ TEST(RenderStages, PinholeLensDrawsTheSameInMapAndVertexModes) {
   std::vector<uint8_t> outputs[2];
   for (int i = 0; i < 2; ++i) {
     Config config = cube_config(4);
-    config.render.lens = i == 0 ? "map" : "vertex";
+    config.render.lens = i == 0 ? LensMode::Map : LensMode::Vertex;
     harness().configure(config);
     FrameContext ctx = make_context(background, pinhole_camera(), oblique_pose());
     harness().process(ctx);
@@ -356,7 +356,7 @@ TEST(RenderStages, DisabledRenderingIsAPassThrough) {
 
 TEST(RenderStages, UnsupportedLensModelIsRecordedAndPassesThrough) {
   Config config = cube_config(4);
-  config.render.lens = "vertex";  // the vertex shader knows PINHOLE and OPENCVn only
+  config.render.lens = LensMode::Vertex;  // the vertex shader knows PINHOLE and OPENCVn only
   harness().configure(config);
   const Frame camera_frame = yuyv_camera_frame();
   auto stereographic =
@@ -486,7 +486,7 @@ TEST(RenderStages, UnknownBuiltinMeshFailsConfigureNamingTheKey) {
 
 TEST(RenderStages, UndistortModeUndistortsEveryFrameAndSaysSo) {
   Config config = cube_config(4);
-  config.render.lens = "undistort";
+  config.render.lens = LensMode::Undistort;
   harness().configure(config);
   const Frame camera_frame = yuyv_camera_frame();
   Frame rgb = Frame::allocate(PixelFormat::RGB24, kWidth, kHeight);

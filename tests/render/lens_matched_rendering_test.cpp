@@ -144,7 +144,7 @@ Config cubes_config(const Capture& capture, const std::string& lens_mode) {
   config.render.light_color = {1, 1, 1};
   config.render.ambient = {0, 0, 0};
   config.render.msaa_samples = 4;
-  config.render.lens = lens_mode;
+  config.render.lens = *choice_value(kLensModeNames, lens_mode);
   return config;
 }
 

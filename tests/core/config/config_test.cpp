@@ -45,7 +45,7 @@ TEST(Config, DefaultsAreTheDocumentedOnes) {
   EXPECT_EQ(c.track.bundle[0].id, 0);
   EXPECT_EQ(c.track.bundle[0].size_m, 0.1);
   EXPECT_EQ(c.render.msaa_samples, 4);
-  EXPECT_EQ(c.render.lens, "map");
+  EXPECT_EQ(c.render.lens, LensMode::Map);
   EXPECT_EQ(c.render.lens_canvas_scale, 1.5);
   EXPECT_EQ(c.pipeline.queue_depth, 4);
   EXPECT_EQ(c.pipeline.log_level, "info");
@@ -177,7 +177,7 @@ log_level = "debug"
   EXPECT_EQ(c.render.ambient, (Vec3{0.1, 0.1, 0.2}));
   EXPECT_EQ(c.render.msaa_samples, 2);
   EXPECT_EQ(c.render.egl_platform, "surfaceless");
-  EXPECT_EQ(c.render.lens, "undistort");
+  EXPECT_EQ(c.render.lens, LensMode::Undistort);
   EXPECT_EQ(c.render.lens_canvas_scale, 2.0);
   ASSERT_EQ(c.render.objects.size(), 2u);
   EXPECT_EQ(c.render.objects[0].mesh, "builtin:pyramid");
@@ -368,7 +368,7 @@ TEST(Config, OverridesReplaceKeysBeforeValidation) {
   EXPECT_EQ(c.render.objects[1].scale, 0.25);
   EXPECT_EQ(c.sinks.png.dir, "out/run1");
   EXPECT_EQ(c.render.ambient, (Vec3{0.5, 0.5, 0.5}));
-  EXPECT_EQ(c.render.lens, "vertex");
+  EXPECT_EQ(c.render.lens, LensMode::Vertex);
   // Later overrides win; an inline table replaces the whole table.
   const Config d = parse_config("[source]\npath = \"a\"\nloop = true\n", "o.toml",
                                 {"pipeline.max_frames=5", "pipeline.max_frames=6", "source={path=\"b\"}"});
