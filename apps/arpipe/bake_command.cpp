@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 
 #include <cstdio>
-#include <exception>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -45,23 +44,18 @@ int bake(BakeOptions options) {
   }
 
   Mesh mesh;
-  try {
-    if (is_builtin_mesh_source(model)) {
-      std::optional<Mesh> builtin = make_builtin_mesh(model);
-      if (!builtin) {
-        std::fprintf(stderr, "arpipe bake: unknown builtin mesh \"%s\" (known: %s)\n", model.c_str(),
-                     std::string(kBuiltinMeshNames).c_str());
-        return 1;
-      }
-      mesh = std::move(*builtin);
-    } else {
-      mesh = load_gltf_mesh(model);
+  if (is_builtin_mesh_source(model)) {
+    std::optional<Mesh> builtin = make_builtin_mesh(model);
+    if (!builtin) {
+      std::fprintf(stderr, "arpipe bake: unknown builtin mesh \"%s\" (known: %s)\n", model.c_str(),
+                   std::string(kBuiltinMeshNames).c_str());
+      return 1;
     }
-    validate_prt_mesh(mesh);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "arpipe bake: %s\n", e.what());
-    return 1;
+    mesh = std::move(*builtin);
+  } else {
+    mesh = load_gltf_mesh(model);
   }
+  validate_prt_mesh(mesh);
 
   const std::string key = prt_cache_key(mesh, settings);
   const fs::path file = prt_cache_file(cache_dir, key);
@@ -77,20 +71,15 @@ int bake(BakeOptions options) {
   }
   std::printf("baking:  %s\n", force ? "--force" : why_not.c_str());
   std::fflush(stdout);
-  try {
-    ProgressBar bar("vertices");
-    PrtBakeStats stats;
-    const PrtTransfer transfer = bake_prt(
-        mesh, settings, [&](size_t done, size_t total) { bar.update(int(done), int(total)); }, &stats);
-    bar.finish();
-    write_prt_cache(file, key, transfer);
-    std::printf("baked in %.2f s on %d threads: %llu rays, %.2f Mrays/s\n", stats.seconds, stats.threads,
-                static_cast<unsigned long long>(stats.rays),
-                stats.seconds > 0 ? double(stats.rays) / stats.seconds * 1e-6 : 0.0);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "arpipe bake: %s\n", e.what());
-    return 1;
-  }
+  ProgressBar bar("vertices");
+  PrtBakeStats stats;
+  const PrtTransfer transfer = bake_prt(
+      mesh, settings, [&](size_t done, size_t total) { bar.update(int(done), int(total)); }, &stats);
+  bar.finish();
+  write_prt_cache(file, key, transfer);
+  std::printf("baked in %.2f s on %d threads: %llu rays, %.2f Mrays/s\n", stats.seconds, stats.threads,
+              static_cast<unsigned long long>(stats.rays),
+              stats.seconds > 0 ? double(stats.rays) / stats.seconds * 1e-6 : 0.0);
   return 0;
 }
 
@@ -116,7 +105,8 @@ void add_bake_command(CLI::App& arpipe) {
       ->default_str("$XDG_CACHE_HOME/arpipe/prt or ~/.cache/arpipe/prt")
       ->check(cli::accepted_by([](const std::string& t) { return !t.empty(); }, "a directory"));
   command->add_flag("--force", options->force, "bake even when the cache holds an up-to-date result");
-  cli::on_run(command, [options] { return bake(*options); });
+  cli::on_run(command, [options] { return bake(*options); },
+              cli::Failure{.status = 1, .message = cli::Failure::Message::after_command_name});
 }
 
 }  // namespace arpipe

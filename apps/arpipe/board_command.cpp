@@ -2,7 +2,6 @@
 #include <fmt/format.h>
 
 #include <cstdio>
-#include <exception>
 #include <memory>
 #include <string>
 
@@ -10,7 +9,6 @@
 #include "apps/cli/command_line.h"
 #include "calib/board_printout.h"
 #include "calib/calibration_board.h"
-#include "core/log.h"
 
 namespace arpipe {
 
@@ -25,18 +23,13 @@ int draw_board(const BoardOptions& options) {
   const std::string& board_path = options.board_path;
   const std::string& out = options.out;
   const double dpi = options.dpi;
-  try {
-    const calib::CalibrationBoard board = calib::load_board(board_path);
-    const calib::PrintedBoard printed = calib::write_board_png(board, out, dpi);
-    fmt::print("wrote {}: {}x{} px; print at {:g} dpi, 100 % scale: {:.1f} x {:.1f} mm with the margin; {} {:.1f} mm\n",
-               out, printed.width_px, printed.height_px, dpi, 1e3 * printed.width_m, 1e3 * printed.height_m,
-               board.kind == calib::BoardKind::chessboard ? "each square must measure" : "each tag's black square must measure",
-               1e3 * (board.kind == calib::BoardKind::chessboard ? board.spacing_m : board.tag_size_m));
-    return 0;
-  } catch (const std::exception& e) {
-    log::error("{}", e.what());
-    return 1;
-  }
+  const calib::CalibrationBoard board = calib::load_board(board_path);
+  const calib::PrintedBoard printed = calib::write_board_png(board, out, dpi);
+  fmt::print("wrote {}: {}x{} px; print at {:g} dpi, 100 % scale: {:.1f} x {:.1f} mm with the margin; {} {:.1f} mm\n",
+             out, printed.width_px, printed.height_px, dpi, 1e3 * printed.width_m, 1e3 * printed.height_m,
+             board.kind == calib::BoardKind::chessboard ? "each square must measure" : "each tag's black square must measure",
+             1e3 * (board.kind == calib::BoardKind::chessboard ? board.spacing_m : board.tag_size_m));
+  return 0;
 }
 
 }  // namespace
@@ -50,7 +43,7 @@ void add_board_command(CLI::App& arpipe) {
   command->add_option("FILE", options->board_path, "the board file (configs/boards/*.toml)")->required();
   command->add_option("--out", options->out, "the picture")->type_name("BOARD.png")->required();
   command->add_option("--dpi", options->dpi, "pixels per inch")->check(CLI::PositiveNumber);
-  cli::on_run(command, [options] { return draw_board(*options); });
+  cli::on_run(command, [options] { return draw_board(*options); }, cli::Failure{.status = 1});
 }
 
 }  // namespace arpipe

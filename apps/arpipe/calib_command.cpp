@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <exception>
 #include <fstream>
 #include <memory>
 #include <optional>
@@ -56,44 +55,39 @@ int calibrate(const CalibOptions& command) {
   calib::SolveOptions options = command.solve;
   if (options.lensmodel.rfind("LENSMODEL_", 0) != 0) options.lensmodel = "LENSMODEL_" + options.lensmodel;
   const int threads = command.threads;
-  try {
-    const calib::CalibrationBoard board = calib::load_board(board_path);
-    const auto images = images_glob.empty() ? calib::images_from_recording(recording)
-                                            : calib::images_from_glob(images_glob);
-    std::optional<ProgressBar> bars[2];  // made when their pass starts: the bar times from its creation
-    calib::CalibrationRunProgress progress;
-    progress.detection = [&bars](int pass, int done, int total) {
-      std::optional<ProgressBar>& bar = bars[pass == 1 ? 0 : 1];
-      if (!bar) bar.emplace(pass == 1 ? "images" : "images (tag centres through the first solve's lens)");
-      bar->update(done, total);
-      if (done == total) bar->finish();
-    };
-    progress.solve = [](int stage, int stages, const std::string& name) {
-      log::info("solve stage {}/{}: {}", stage + 1, stages, name);
-    };
-    const calib::CalibrationRun run = calib::run_calibration(*images, board, options, threads, progress);
-    const calib::DetectionSet& found = run.found;
-    const calib::CalibrationResult& result = run.result;
-    log::info("found the board in {} of {} images ({}x{})", found.views.size(), found.images, found.width,
-              found.height);
-    if (run.first_pass_rms_per_point_px)
-      log::info("second pass with the lens: RMS per point {:.3f} px (first pass {:.3f} px)", result.rms_per_point_px,
-                *run.first_pass_rms_per_point_px);
-    const calib::CalibrationReport report = calib::make_report(result, found.images, found.without_board);
+  const calib::CalibrationBoard board = calib::load_board(board_path);
+  const auto images = images_glob.empty() ? calib::images_from_recording(recording)
+                                          : calib::images_from_glob(images_glob);
+  std::optional<ProgressBar> bars[2];  // made when their pass starts: the bar times from its creation
+  calib::CalibrationRunProgress progress;
+  progress.detection = [&bars](int pass, int done, int total) {
+    std::optional<ProgressBar>& bar = bars[pass == 1 ? 0 : 1];
+    if (!bar) bar.emplace(pass == 1 ? "images" : "images (tag centres through the first solve's lens)");
+    bar->update(done, total);
+    if (done == total) bar->finish();
+  };
+  progress.solve = [](int stage, int stages, const std::string& name) {
+    log::info("solve stage {}/{}: {}", stage + 1, stages, name);
+  };
+  const calib::CalibrationRun run = calib::run_calibration(*images, board, options, threads, progress);
+  const calib::DetectionSet& found = run.found;
+  const calib::CalibrationResult& result = run.result;
+  log::info("found the board in {} of {} images ({}x{})", found.views.size(), found.images, found.width,
+            found.height);
+  if (run.first_pass_rms_per_point_px)
+    log::info("second pass with the lens: RMS per point {:.3f} px (first pass {:.3f} px)", result.rms_per_point_px,
+              *run.first_pass_rms_per_point_px);
+  const calib::CalibrationReport report = calib::make_report(result, found.images, found.without_board);
 
-    // The model last: a failure writing the extras leaves no model that looks finished.
-    calib::write_corners_vnl(beside(out, ".corners.vnl"), found.views, board);  // as detected: mrcal redoes its own outlier rejection
-    write_text(beside(out, ".report.txt"), calib::report_text(report));
-    write_text(beside(out, ".report.json"), calib::report_json(report));
-    calib::write_residual_image(beside(out, ".residuals.png"), result);
-    result.model.save(out);
-    std::fputs(calib::report_text(report).c_str(), stdout);
-    log::info("wrote {} (and its report, residual picture and corners beside it)", out.string());
-    return 0;
-  } catch (const std::exception& e) {
-    log::error("{}", e.what());
-    return 1;
-  }
+  // The model last: a failure writing the extras leaves no model that looks finished.
+  calib::write_corners_vnl(beside(out, ".corners.vnl"), found.views, board);  // as detected: mrcal redoes its own outlier rejection
+  write_text(beside(out, ".report.txt"), calib::report_text(report));
+  write_text(beside(out, ".report.json"), calib::report_json(report));
+  calib::write_residual_image(beside(out, ".residuals.png"), result);
+  result.model.save(out);
+  std::fputs(calib::report_text(report).c_str(), stdout);
+  log::info("wrote {} (and its report, residual picture and corners beside it)", out.string());
+  return 0;
 }
 
 }  // namespace
@@ -130,7 +124,7 @@ void add_calib_command(CLI::App& arpipe) {
     if ((!*images && !*recording) || options->board_path.empty() || options->out.empty())
       cli::usage_error("give one of --images and --recording, and --board and --out");
     return calibrate(*options);
-  });
+  }, cli::Failure{.status = 1});
 }
 
 }  // namespace arpipe

@@ -1,7 +1,6 @@
 // arpipe config: print the defaults, or check a config file the way arpiped would read it, and
 // that every input file it names exists and is a regular, readable file.
 #include <cstdio>
-#include <exception>
 #include <memory>
 #include <new>
 
@@ -22,9 +21,6 @@ int check(const std::string& file) {
     return 0;
   } catch (const std::bad_alloc&) {  // the loaders cap what they allocate; this names the file if one did not
     log::error("{}: out of memory while checking the config", file);
-    return 2;
-  } catch (const std::exception& e) {
-    log::error("{}", e.what());
     return 2;
   }
 }
@@ -47,7 +43,7 @@ void add_config_command(CLI::App& arpipe) {
       return 0;
     }
     return check(*check_file);
-  });
+  }, cli::Failure{.status = 2});
 }
 
 }  // namespace arpipe

@@ -15,17 +15,6 @@ int main(int argc, char** argv) {
   CLI::App app("arpipe: the utility beside the arpiped daemon.", "arpipe");
   arpipe::cli::setup(app);
   app.require_subcommand(1);
-  arpipe::add_inspect_command(app);
-  arpipe::add_replay_command(app);
-  arpipe::add_simulate_command(app);
-  arpipe::add_calib_command(app);
-  arpipe::add_board_command(app);
-  arpipe::add_bench_command(app);
-  arpipe::add_sh_command(app);
-  arpipe::add_bake_command(app);
-  arpipe::add_sun_command(app);
-  arpipe::add_cameras_command(app);
-  arpipe::add_record_command(app);
-  arpipe::add_config_command(app);
+  for (const arpipe::AddCommand add_command : arpipe::kCommands) add_command(app);
   return arpipe::cli::parse_and_run(app, argc, argv);
 }

@@ -14,7 +14,6 @@
 #include "capture/live/live_source.h"
 #include "capture/recording/recording_writer.h"
 #include "core/config/config.h"
-#include "core/log.h"
 #include "core/pipeline/monotonic_clock.h"
 
 namespace arpipe {
@@ -64,50 +63,45 @@ int record(RecordOptions options) {
   if (!camera_overrides(camera, overrides)) cli::usage_error("--camera: expected /dev/videoN, v4l2:PATH or libcamera:ID");
   if (!model_path.empty()) overrides.push_back("source.camera_model=" + toml_string(model_path));
 
-  try {
-    const Config config = config_path.empty() ? parse_config("", "(defaults)", overrides)
-                                              : load_config(config_path, overrides);
-    auto source = make_live_source(config.source);
-    const StreamFormat& format = source->format();
-    const CameraModel model = source->camera_model() ? *source->camera_model() : nominal_model(format.width, format.height);
-    RecordingInfo info;
-    info.pixel_format = format.format;
-    info.width = format.width;
-    info.height = format.height;
-    info.source = fmt::format("arpipe record {} ({}{}); camera model: {}", source->describe(), format.camera_format,
-                              format.camera_format == std::string(pixel_format_name(format.format)) ? "" : ", decoded",
-                              source->camera_model() ? model_path : "nominal pinhole, not calibrated");
-    RecordingWriter writer(out, info, model);
+  const Config config = config_path.empty() ? parse_config("", "(defaults)", overrides)
+                                            : load_config(config_path, overrides);
+  auto source = make_live_source(config.source);
+  const StreamFormat& format = source->format();
+  const CameraModel model = source->camera_model() ? *source->camera_model() : nominal_model(format.width, format.height);
+  RecordingInfo info;
+  info.pixel_format = format.format;
+  info.width = format.width;
+  info.height = format.height;
+  info.source = fmt::format("arpipe record {} ({}{}); camera model: {}", source->describe(), format.camera_format,
+                            format.camera_format == std::string(pixel_format_name(format.format)) ? "" : ", decoded",
+                            source->camera_model() ? model_path : "nominal pinhole, not calibrated");
+  RecordingWriter writer(out, info, model);
 
-    std::signal(SIGINT, on_signal);
-    std::signal(SIGTERM, on_signal);
-    const int64_t start = monotonic_now_ns();
-    const int64_t end = seconds > 0 ? start + int64_t(seconds * 1e9) : 0;
-    Frame frame;
-    while (!g_stop) {
-      if (frames > 0 && int64_t(writer.frames_written()) >= frames) break;
-      if (end > 0 && monotonic_now_ns() >= end) break;
-      if (source->next(frame) != SourceStatus::Frame) continue;
-      if (frame.bytes_per_line != writer.info().bytes_per_line) {  // a driver with padded lines: repack
-        Frame packed = Frame::allocate(frame.format, frame.width, frame.height);
-        const size_t rows = image_bytes(frame.format, frame.width, frame.height, frame.bytes_per_line) / frame.bytes_per_line;
-        for (size_t r = 0; r < rows; ++r)
-          std::copy_n(frame.data.data() + r * frame.bytes_per_line, packed.bytes_per_line,
-                      packed.data.data() + r * packed.bytes_per_line);
-        packed.meta = frame.meta;
-        frame = std::move(packed);
-      }
-      writer.append(frame);
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  const int64_t start = monotonic_now_ns();
+  const int64_t end = seconds > 0 ? start + int64_t(seconds * 1e9) : 0;
+  Frame frame;
+  while (!g_stop) {
+    if (frames > 0 && int64_t(writer.frames_written()) >= frames) break;
+    if (end > 0 && monotonic_now_ns() >= end) break;
+    if (source->next(frame) != SourceStatus::Frame) continue;
+    if (frame.bytes_per_line != writer.info().bytes_per_line) {  // a driver with padded lines: repack
+      Frame packed = Frame::allocate(frame.format, frame.width, frame.height);
+      const size_t rows = image_bytes(frame.format, frame.width, frame.height, frame.bytes_per_line) / frame.bytes_per_line;
+      for (size_t r = 0; r < rows; ++r)
+        std::copy_n(frame.data.data() + r * frame.bytes_per_line, packed.bytes_per_line,
+                    packed.data.data() + r * packed.bytes_per_line);
+      packed.meta = frame.meta;
+      frame = std::move(packed);
     }
-    writer.flush();
-    const LiveCounters counters = source->counters();
-    fmt::print("recorded {} frames to {} ({:.1f} s); {}\n", writer.frames_written(), out,
-               double(monotonic_now_ns() - start) * 1e-9, LiveSource::describe(counters));
-    return 0;
-  } catch (const std::exception& e) {
-    log::error("{}", e.what());
-    return 2;
+    writer.append(frame);
   }
+  writer.flush();
+  const LiveCounters counters = source->counters();
+  fmt::print("recorded {} frames to {} ({:.1f} s); {}\n", writer.frames_written(), out,
+             double(monotonic_now_ns() - start) * 1e-9, LiveSource::describe(counters));
+  return 0;
 }
 
 }  // namespace
@@ -152,7 +146,7 @@ void add_record_command(CLI::App& arpipe) {
   command->add_option("--set", options->overrides, "override one config key (VALUE in TOML syntax); repeatable")
       ->type_name("KEY=VALUE")
       ->allow_extra_args(false);
-  cli::on_run(command, [options] { return record(*options); });
+  cli::on_run(command, [options] { return record(*options); }, cli::Failure{.status = 2});
 }
 
 }  // namespace arpipe

@@ -2,7 +2,6 @@
 #include <fmt/format.h>
 
 #include <cstdio>
-#include <exception>
 #include <memory>
 #include <string>
 #include <vector>
@@ -29,18 +28,13 @@ int replay(ReplayOptions options) {
   overrides.push_back("source.type=\"replay\"");
   overrides.push_back("source.pacing=\"fast\"");
   overrides.push_back(fmt::format("source.path={}", toml_string(dir)));
-  try {
-    const Config config = config_path.empty() ? parse_config("", "(defaults)", overrides)
-                                              : load_config(config_path, overrides);
-    auto runner = assemble_pipeline(config);
-    runner->start();
-    runner->wait();
-    log::info("{}", describe_metrics(runner->metrics()));
-    return 0;
-  } catch (const std::exception& e) {
-    log::error("{}", e.what());
-    return 2;
-  }
+  const Config config = config_path.empty() ? parse_config("", "(defaults)", overrides)
+                                            : load_config(config_path, overrides);
+  auto runner = assemble_pipeline(config);
+  runner->start();
+  runner->wait();
+  log::info("{}", describe_metrics(runner->metrics()));
+  return 0;
 }
 
 }  // namespace
@@ -54,7 +48,7 @@ void add_replay_command(CLI::App& arpipe) {
   command->add_option("--set", options->overrides, "override one config key (VALUE in TOML syntax); repeatable")
       ->type_name("KEY=VALUE")
       ->allow_extra_args(false);
-  cli::on_run(command, [options] { return replay(*options); });
+  cli::on_run(command, [options] { return replay(*options); }, cli::Failure{.status = 2});
 }
 
 }  // namespace arpipe

@@ -113,57 +113,52 @@ int run_sh(const ShOptions& options) {
   for (const std::string& text : options.normals) normals.push_back(*parse_direction(text));
 
   const Mat3 R_world_probe = default_world_from_probe(yaw_deg * std::numbers::pi / 180);
-  try {
-    const HdrEnvironment environment = HdrEnvironment::load(probe_file, *layout, R_world_probe, scale);
-    const auto start = std::chrono::steady_clock::now();
-    ShRgb sh;
-    if (method == "texels") {
-      sh = project_environment(environment, bands);
-    } else {
-      const SphereSamples sphere = stratified_sphere_samples(samples, bands, 1);
-      sh = project_samples(sphere, [&](const Vec3& d) { return environment.radiance(d); });
+  const HdrEnvironment environment = HdrEnvironment::load(probe_file, *layout, R_world_probe, scale);
+  const auto start = std::chrono::steady_clock::now();
+  ShRgb sh;
+  if (method == "texels") {
+    sh = project_environment(environment, bands);
+  } else {
+    const SphereSamples sphere = stratified_sphere_samples(samples, bands, 1);
+    sh = project_samples(sphere, [&](const Vec3& d) { return environment.radiance(d); });
+  }
+  const double ms = 1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  apply_sh_window(sh, *window);
+  fmt::print("probe {} ({} x {}, {}), scale {}, yaw {} deg\n", probe_file, environment.width(), environment.height(),
+             environment_layout_name(*layout), scale, yaw_deg);
+  fmt::print("radiance SH, {} bands, {} ({:.1f} ms), window {}\n", bands,
+             method == "texels" ? std::string("per-texel solid angles") : fmt::format("{0} x {0} jittered samples", samples),
+             ms, window_name);
+  fmt::print("  {:>3} {:>3} {:>3}  {:>12} {:>12} {:>12}\n", "i", "l", "m", "R", "G", "B");
+  for (int l = 0; l < bands; ++l)
+    for (int m = -l; m <= l; ++m) {
+      const Vec3& c = sh.c[size_t(sh_index(l, m))];
+      fmt::print("  {:>3} {:>3} {:>3}  {:>12.6g} {:>12.6g} {:>12.6g}\n", sh_index(l, m), l, m, c[0], c[1], c[2]);
     }
-    const double ms = 1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    apply_sh_window(sh, *window);
-    fmt::print("probe {} ({} x {}, {}), scale {}, yaw {} deg\n", probe_file, environment.width(), environment.height(),
-               environment_layout_name(*layout), scale, yaw_deg);
-    fmt::print("radiance SH, {} bands, {} ({:.1f} ms), window {}\n", bands,
-               method == "texels" ? std::string("per-texel solid angles") : fmt::format("{0} x {0} jittered samples", samples),
-               ms, window_name);
-    fmt::print("  {:>3} {:>3} {:>3}  {:>12} {:>12} {:>12}\n", "i", "l", "m", "R", "G", "B");
-    for (int l = 0; l < bands; ++l)
-      for (int m = -l; m <= l; ++m) {
-        const Vec3& c = sh.c[size_t(sh_index(l, m))];
-        fmt::print("  {:>3} {:>3} {:>3}  {:>12.6g} {:>12.6g} {:>12.6g}\n", sh_index(l, m), l, m, c[0], c[1], c[2]);
-      }
-    fmt::print("band energy (sum of c^2, luminance-weighted):");
-    for (int l = 0; l < bands; ++l) {
-      double energy = 0;
-      for (int m = -l; m <= l; ++m) {
-        const Vec3& c = sh.c[size_t(sh_index(l, m))];
-        const double y = 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
-        energy += y * y;
-      }
-      fmt::print(" {:.4g}", energy);
+  fmt::print("band energy (sum of c^2, luminance-weighted):");
+  for (int l = 0; l < bands; ++l) {
+    double energy = 0;
+    for (int m = -l; m <= l; ++m) {
+      const Vec3& c = sh.c[size_t(sh_index(l, m))];
+      const double y = 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+      energy += y * y;
     }
-    fmt::print("\n");
-    for (const Vec3& n : normals) {
-      const Vec3 e = sh_irradiance(sh, n);
-      fmt::print("irradiance at normal [{:+.4f}, {:+.4f}, {:+.4f}]: [{:.6g}, {:.6g}, {:.6g}] (radiance of a white "
-                 "Lambertian surface: E / pi = [{:.6g}, {:.6g}, {:.6g}])\n",
-                 n[0], n[1], n[2], e[0], e[1], e[2], e[0] / std::numbers::pi, e[1] / std::numbers::pi,
-                 e[2] / std::numbers::pi);
-    }
-    if (!reconstruct_path.empty()) {
-      const HdrImage image = reconstruct(environment, sh, R_world_probe);
-      if (ends_with(reconstruct_path, ".hdr")) write_radiance_hdr(reconstruct_path, image);
-      else if (ends_with(reconstruct_path, ".exr")) write_openexr(reconstruct_path, image);
-      else write_png(reconstruct_path, image);
-      fmt::print("wrote the {}-band reconstruction to {}\n", bands, reconstruct_path);
-    }
-  } catch (const std::exception& e) {
-    fmt::print(stderr, "arpipe sh: {}\n", e.what());
-    return 1;
+    fmt::print(" {:.4g}", energy);
+  }
+  fmt::print("\n");
+  for (const Vec3& n : normals) {
+    const Vec3 e = sh_irradiance(sh, n);
+    fmt::print("irradiance at normal [{:+.4f}, {:+.4f}, {:+.4f}]: [{:.6g}, {:.6g}, {:.6g}] (radiance of a white "
+               "Lambertian surface: E / pi = [{:.6g}, {:.6g}, {:.6g}])\n",
+               n[0], n[1], n[2], e[0], e[1], e[2], e[0] / std::numbers::pi, e[1] / std::numbers::pi,
+               e[2] / std::numbers::pi);
+  }
+  if (!reconstruct_path.empty()) {
+    const HdrImage image = reconstruct(environment, sh, R_world_probe);
+    if (ends_with(reconstruct_path, ".hdr")) write_radiance_hdr(reconstruct_path, image);
+    else if (ends_with(reconstruct_path, ".exr")) write_openexr(reconstruct_path, image);
+    else write_png(reconstruct_path, image);
+    fmt::print("wrote the {}-band reconstruction to {}\n", bands, reconstruct_path);
   }
   return 0;
 }
@@ -207,7 +202,8 @@ void add_sh_command(CLI::App& arpipe) {
   command->add_option("--reconstruct", options->reconstruct_path, "write the band-limited probe")
       ->type_name("OUT.hdr|.exr|.png")
       ->check(cli::accepted_by(is_image_file, "a file ending in .hdr, .exr or .png"));
-  cli::on_run(command, [options] { return run_sh(*options); });
+  cli::on_run(command, [options] { return run_sh(*options); },
+              cli::Failure{.status = 1, .message = cli::Failure::Message::after_command_name});
 }
 
 }  // namespace arpipe

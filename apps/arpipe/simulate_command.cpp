@@ -42,25 +42,20 @@ int run_simulate(SimulateOptions& command) {
     return 2;
   }
   if (samples > 0) scene.render.samples_per_pixel = samples;
-  ProgressBar progress("frames");
-  options.on_frame = [&progress](int done, int total) { progress.update(done, total); };
+  sim::SimulateSummary summary;
   try {
-    const sim::SimulateSummary summary = sim::simulate(scene, options);
-    progress.finish();
-    log::info("wrote {} frames to {} in {:.1f} s ({:.1f} s setup, {:.2f} s per frame{})", summary.frames,
-              options.out_dir.string(), summary.seconds, summary.setup_seconds,
-              (summary.seconds - summary.setup_seconds) / summary.frames,
-              summary.wrote_composite ? ", with the ground-truth composite" : "");
-    return 0;
+    ProgressBar progress("frames");  // its line ends when it goes, before an error is logged
+    options.on_frame = [&progress](int done, int total) { progress.update(done, total); };
+    summary = sim::simulate(scene, options);
   } catch (const std::bad_alloc&) {
-    progress.finish();
     log::error("{}: out of memory while simulating into {}", scene_path, options.out_dir.string());
     return 1;
-  } catch (const std::exception& e) {
-    progress.finish();
-    log::error("{}", e.what());
-    return 1;
   }
+  log::info("wrote {} frames to {} in {:.1f} s ({:.1f} s setup, {:.2f} s per frame{})", summary.frames,
+            options.out_dir.string(), summary.seconds, summary.setup_seconds,
+            (summary.seconds - summary.setup_seconds) / summary.frames,
+            summary.wrote_composite ? ", with the ground-truth composite" : "");
+  return 0;
 }
 
 }  // namespace
@@ -90,7 +85,7 @@ void add_simulate_command(CLI::App& arpipe) {
         }
       }, "a square number"))
       ->default_str("the scene's");
-  cli::on_run(command, [options] { return run_simulate(*options); });
+  cli::on_run(command, [options] { return run_simulate(*options); }, cli::Failure{.status = 1});
 }
 
 }  // namespace arpipe

@@ -1,11 +1,15 @@
 // The command-line conventions both programs share (see command_line.h).
 #include "apps/cli/command_line.h"
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <utility>
 
 #include "arpipe_version.h"  // generated: apps/CMakeLists.txt
+#include "core/log.h"
 
 namespace arpipe::cli {
 
@@ -28,6 +32,14 @@ std::string command_path(const CLI::App* app) {
     path += " " + at->get_name();
   }
   return path;
+}
+
+// "arpipe bake": the command's name after those of the commands it belongs to.
+std::string name_with_parents(const CLI::App* command) {
+  std::string name = command->get_name();
+  for (const CLI::App* parent = command->get_parent(); parent != nullptr; parent = parent->get_parent())
+    name = parent->get_name() + " " + name;
+  return name;
 }
 
 // The help shows defaults that say something: none for a required option or an empty value.
@@ -63,6 +75,22 @@ void on_run(CLI::App* command, std::function<int()> run) {
   command->callback([run = std::move(run)] {
     const int status = run();
     if (status != 0) throw CLI::RuntimeError(status);
+  });
+}
+
+void on_run(CLI::App* command, std::function<int()> run, Failure failure) {
+  on_run(command, [command, run = std::move(run), failure] {
+    try {
+      return run();
+    } catch (const CLI::Error&) {
+      throw;  // a usage error: parse_and_run reports it
+    } catch (const std::exception& e) {
+      if (failure.message == Failure::Message::logged)
+        log::error("{}", e.what());
+      else
+        fmt::print(stderr, "{}: {}\n", name_with_parents(command), e.what());
+      return failure.status;
+    }
   });
 }
 

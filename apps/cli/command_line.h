@@ -20,6 +20,21 @@ void setup(CLI::App& app);
 // What a command does once its options are read; the function's result is the exit status.
 void on_run(CLI::App* command, std::function<int()> run);
 
+// What an error that escapes a command's run function (a file it cannot read, a solve that fails)
+// becomes: the exit status, and how the message is written.
+struct Failure {
+  enum class Message {
+    logged,              // log::error: "arpipe: error: <what>"
+    after_command_name,  // stderr: "arpipe bake: <what>", like the messages such a command prints itself
+  };
+  int status = 1;
+  Message message = Message::logged;
+};
+
+// on_run for a command whose errors are exceptions: one that escapes `run` is reported as
+// `failure` says, so the command needs no catch of its own. Usage errors (usage_error) still exit 2.
+void on_run(CLI::App* command, std::function<int()> run, Failure failure);
+
 // Parses the command line and runs the chosen command: its exit status, 0 after --help or
 // --version, 2 after a usage error (printed to stderr with the command's name).
 int parse_and_run(CLI::App& app, int argc, char** argv);

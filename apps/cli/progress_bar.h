@@ -10,6 +10,9 @@ namespace arpipe {
 class ProgressBar {
  public:
   explicit ProgressBar(std::string what);  // "frames"
+  ~ProgressBar() { finish(); }             // a job that fails midway still ends the bar's line
+  ProgressBar(const ProgressBar&) = delete;
+  ProgressBar& operator=(const ProgressBar&) = delete;
   void update(int done, int total);
   void finish();  // ends the line on a terminal
 
