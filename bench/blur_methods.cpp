@@ -36,9 +36,11 @@ namespace {
 namespace fs = std::filesystem;
 
 struct Variant {
-  std::string method;
+  BlurMethod method = BlurMethod::Off;
   int samples = 0;  // 0: from the motion
-  std::string label() const { return samples > 0 ? fmt::format("{} {}", method, samples) : method + " auto"; }
+  std::string label() const {
+    return samples > 0 ? fmt::format("{} {}", blur_method_name(method), samples) : fmt::format("{} auto", blur_method_name(method));
+  }
 };
 
 // Keeps what tracking and motion found for each frame (pass 1), to draw it again per variant.
@@ -167,9 +169,9 @@ Config bench_config(const fs::path& config_path, const std::vector<std::string>&
     config.render.objects = {SceneObject{}};
     if (fs::exists(capture / "scene.toml")) light_as_the_simulator(sim::load_sim_scene(capture / "scene.toml"), config.render);
   }
-  config.source.type = "replay";
+  config.source.type = SourceType::Replay;
   config.source.path = capture;
-  config.source.pacing = "fast";
+  config.source.pacing = ReplayPacing::Fast;
   config.source.loop = false;
   // Interpolated motion: the best estimate the pipeline can make (one frame of latency).
   config.motion.latency_frames = 1;
@@ -215,7 +217,7 @@ int run_blur_benchmark(BlurOptions options) {
     // Pass 1: tracking and motion, as the daemon runs them.
     Config config = bench_config(config_path, overrides, capture);
     Config track_only = config;
-    track_only.render.blur.method = "off";  // rendering stays on: tracking runs only for something to draw
+    track_only.render.blur.method = BlurMethod::Off;  // rendering stays on: tracking runs only for something to draw
     auto keep = std::make_unique<KeepContexts>();
     KeepContexts* kept = keep.get();
     std::vector<std::unique_ptr<FrameSink>> sinks;
@@ -232,13 +234,13 @@ int run_blur_benchmark(BlurOptions options) {
     const int width = frames.front().camera.width, height = frames.front().camera.height;
 
     // The variants, the converged reference first.
-    std::vector<Variant> variants{{"accumulate", reference_samples}, {"off", 0}};
-    for (int n : {4, 8, 16, 32, 64}) variants.push_back({"accumulate", n});
-    variants.push_back({"accumulate", 0});
-    for (int n : {4, 8, 16, 32, 50}) variants.push_back({"seed", n});
-    variants.push_back({"seed", 0});
-    for (int n : {4, 8, 16, 32}) variants.push_back({"velocity", n});
-    variants.push_back({"velocity", 0});
+    std::vector<Variant> variants{{BlurMethod::Accumulate, reference_samples}, {BlurMethod::Off, 0}};
+    for (int n : {4, 8, 16, 32, 64}) variants.push_back({BlurMethod::Accumulate, n});
+    variants.push_back({BlurMethod::Accumulate, 0});
+    for (int n : {4, 8, 16, 32, 50}) variants.push_back({BlurMethod::IntraframeWarp, n});
+    variants.push_back({BlurMethod::IntraframeWarp, 0});
+    for (int n : {4, 8, 16, 32}) variants.push_back({BlurMethod::Velocity, n});
+    variants.push_back({BlurMethod::Velocity, 0});
 
     std::vector<std::vector<Rendered>> results;
     ProgressBar progress("variants");
@@ -302,7 +304,7 @@ int run_blur_benchmark(BlurOptions options) {
     // Frames without motion: each method's default against the no-blur path on the same frames,
     // interleaved and repeated, so that the comparison does not depend on when each ran.
     constexpr int kStillRepeats = 30;
-    const std::vector<Variant> still_variants{{"off", 0}, {"accumulate", 0}, {"seed", 0}, {"velocity", 0}};
+    const std::vector<Variant> still_variants{{BlurMethod::Off, 0}, {BlurMethod::Accumulate, 0}, {BlurMethod::IntraframeWarp, 0}, {BlurMethod::Velocity, 0}};
     std::vector<VariantRenderer> renderers;
     for (const Variant& variant : still_variants) renderers.emplace_back(config, variant, frames.front().camera_model);
     std::vector<std::vector<double>> still_ms(still_variants.size());

@@ -43,8 +43,8 @@ Config scene(const std::string& mesh, const std::string& prt, const std::filesys
       object.prt = prt;
       config.render.objects.push_back(object);
     }
-  config.render.shadows.method = "off";
-  config.render.blur.method = "off";
+  config.render.shadows.method = ShadowMethod::Off;
+  config.render.blur.method = BlurMethod::Off;
   config.render.prt.cache_dir = cache_dir;
   return config;
 }

@@ -6,6 +6,8 @@
 #include <map>
 #include <memory>
 #include <numbers>
+#include <optional>
+#include <stdexcept>
 #include <vector>
 
 #include "capture/sim/sim_scene_loader.h"
@@ -59,7 +61,10 @@ ShadowScene sun_outdoor_shadow_scene() {
 Config shadow_config(const ShadowScene& scene, const std::string& method_and_kernel, int map_size) {
   // "pcf:8": the method, and the PCF kernel after a colon.
   const size_t colon = method_and_kernel.find(':');
-  const std::string method = method_and_kernel.substr(0, colon);
+  const std::string method_name = method_and_kernel.substr(0, colon);
+  const std::optional<ShadowMethod> method = choice_value(kShadowMethodNames, method_name);
+  if (!method) throw std::invalid_argument(fmt::format("shadow method \"{}\": expected one of {}", method_name,
+                                                       choice_list(ChoiceNames<ShadowMethod>(kShadowMethodNames))));
   Config config;
   if (colon != std::string::npos) config.render.shadows.pcf_kernel = std::stoi(method_and_kernel.substr(colon + 1));
   config.render.objects = {SceneObject{}};
@@ -74,11 +79,11 @@ Config shadow_config(const ShadowScene& scene, const std::string& method_and_ker
   }
   config.render.light_color = (1 / std::numbers::pi) * scene.direct;
   config.render.ambient = (1 / std::numbers::pi) * scene.ambient;
-  config.render.shadows.method = method;
+  config.render.shadows.method = *method;
   config.render.shadows.map_size = map_size;
   config.render.shadows.receiver_height_m = -0.0005;
   config.render.shadows.light_angular_diameter_deg = scene.light_diameter_rad * 180 / std::numbers::pi;
-  config.render.blur.method = "off";
+  config.render.blur.method = BlurMethod::Off;
   return config;
 }
 

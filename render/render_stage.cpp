@@ -68,7 +68,7 @@ void RenderStage::configure_loaded(const Config& config, const std::shared_ptr<c
   session_->ensure_context(config.render.egl_platform);
   session_->make_current();
   if (!drawer_) drawer_ = std::make_unique<MotionBlurDrawer>(session_->context(), session_->layer().color_format());
-  drawer_->prepare(parse_blur_method(config.render.blur.method));
+  drawer_->prepare(config.render.blur.method);
   std::vector<UploadedObject> objects = upload_objects(config, loaded->meshes);
 
   Settings settings;
@@ -85,7 +85,7 @@ void RenderStage::configure_loaded(const Config& config, const std::shared_ptr<c
   settings.max_predicted_uncertainty_deg = config.render.max_predicted_uncertainty_deg;
   settings.blur = config.render.blur;
   settings.shadows = config.render.shadows;
-  settings.shadow_method = parse_shadow_method(config.render.shadows.method);
+  settings.shadow_method = config.render.shadows.method;
   drawer_->prepare_shadows(settings.shadow_method);
   if (settings.shadow_method == ShadowMethod::Off) {
     shadow_pass_.reset();

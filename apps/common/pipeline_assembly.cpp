@@ -18,10 +18,13 @@
 namespace arpipe {
 
 std::unique_ptr<FrameSource> make_source(const Config& config) {
-  if (config.source.type == "replay") return std::make_unique<ReplaySource>(config.source);
-  if (config.source.type == "v4l2" || config.source.type == "libcamera") return make_live_source(config.source);
-  throw ConfigError(fmt::format("{}: source.type \"{}\" is not supported (expected \"replay\", \"v4l2\" or \"libcamera\")",
-                                config.file.string(), config.source.type));
+  switch (config.source.type) {
+    case SourceType::Replay: return std::make_unique<ReplaySource>(config.source);
+    case SourceType::V4l2:
+    case SourceType::Libcamera: return make_live_source(config.source);
+  }
+  throw ConfigError(fmt::format("{}: source.type is not one of {}", config.file.string(),
+                                choice_list(ChoiceNames<SourceType>(kSourceTypeNames))));
 }
 
 namespace {
@@ -56,7 +59,7 @@ StageFactory make_stage_factory() {
         [](const Config& c) { return c.track.enabled && c.motion.enabled; },
         [] { return std::make_unique<MotionStage>(); }));
     // The fixed light needs no stage: the renderer takes it from the config.
-    stages.push_back(std::make_unique<OptionalStage>([](const Config& c) { return c.light.source != "fixed"; },
+    stages.push_back(std::make_unique<OptionalStage>([](const Config& c) { return c.light.source != LightSource::Fixed; },
                                                      [] { return std::make_unique<LightStage>(); }));
     for (auto& stage : make_gl_stages()) stages.push_back(std::move(stage));
     return stages;

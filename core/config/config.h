@@ -9,7 +9,12 @@
 #include <vector>
 
 #include "core/config/config_rules.h"
+#include "core/config/blur_method.h"
 #include "core/config/lens_mode.h"
+#include "core/config/log_level_names.h"
+#include "core/config/source_choices.h"
+#include "core/config/light_source.h"
+#include "core/config/shadow_method.h"
 #include "core/geometry/vec.h"
 #include "core/image/camera_response.h"
 
@@ -22,9 +27,9 @@ class ConfigError : public std::runtime_error {
 };
 
 struct SourceConfig {
-  std::string type = "replay";          // "replay", "v4l2" or "libcamera"
+  SourceType type = SourceType::Replay;
   std::filesystem::path path;           // replay: the recording directory
-  std::string pacing = "timestamps";    // replay: "timestamps" (real time) or "fast"
+  ReplayPacing pacing = ReplayPacing::Timestamps;  // replay only
   bool loop = false;                    // replay: start again at the end (soak tests)
   int64_t timestamp_offset_ns = 0;      // added to every exposure_start_ns of this camera
   std::filesystem::path camera_model;   // overrides the recording's camera model; live: required to track
@@ -32,18 +37,18 @@ struct SourceConfig {
   // Live cameras (v4l2, libcamera). 0 or "auto": whatever the camera offers first.
   std::string device;                   // v4l2: /dev/videoN or a /dev/v4l/by-id|by-path link
   std::string camera;                   // libcamera: camera id, or its index in the list ("" = first)
-  std::string role = "video";           // libcamera stream role: video, viewfinder, still, raw
+  StreamRole role = StreamRole::Video;  // libcamera only
   int width = 0;
   int height = 0;
   double fps = 0;
-  std::string pixel_format = "auto";    // YUYV, NV12, RGB24, GREY, MJPG (v4l2: decoded to RGB24), auto
+  CaptureFormat pixel_format = CaptureFormat::Auto;  // MJPG: v4l2 only, decoded to RGB24
   int buffers = 4;                      // capture buffers (at least 4)
   int64_t exposure_us = 0;              // manual exposure; 0: auto exposure
   double gain = 0;                      // manual analogue gain (1 = unity); 0: auto
   double gain_unity = 100;              // v4l2: the gain control's value that means gain 1
   // v4l2: what the buffer timestamps mean when the driver does not say (no TSTAMP_SRC flag), or
   // "auto" to take the driver's flag (end-of-frame when it gives none).
-  std::string timestamp_meaning = "auto";  // auto, start-of-exposure, end-of-frame
+  BufferTimestamps timestamp_meaning = BufferTimestamps::DriverFlag;
   int64_t readout_ns = 0;               // rolling-shutter readout (first to last row); 0: global
   int64_t frame_timeout_ms = 1000;      // a frame later than this is a timeout (counted)
   int64_t reconnect_min_ms = 100;       // first retry after a camera disappeared
@@ -56,9 +61,9 @@ struct SourceConfig {
 // rule the value must meet, and the help `arpipe config --defaults` prints (docs/ARCHITECTURE.md, "Adding a config key").
 template <class V>
 void visit(V& v, SourceConfig& s) {
-  v.key("type", s.type, OneOf{{"replay", "v4l2", "libcamera"}}, "a recording, a V4L2 device or a libcamera camera");
+  v.key("type", s.type, kSourceTypeNames, "a recording, a V4L2 device or a libcamera camera");
   v.key("path", s.path, "replay: the recording directory");
-  v.key("pacing", s.pacing, OneOf{{"timestamps", "fast"}}, "replay: real time, or as fast as the pipeline runs");
+  v.key("pacing", s.pacing, kReplayPacingNames, "replay: real time, or as fast as the pipeline runs");
   v.key("loop", s.loop, "replay: start again at the end (soak tests)");
   // Drivers disagree about their timestamps by a frame or two; an hour keeps every exposure time
   // plus the offset inside int64 nanoseconds.
@@ -67,18 +72,18 @@ void visit(V& v, SourceConfig& s) {
   v.key("camera_model", s.camera_model, "a .cameramodel to use instead of the recording's (live: needed to track)");
   v.key("device", s.device, "v4l2: /dev/videoN or a /dev/v4l/by-id or by-path link");
   v.key("camera", s.camera, "libcamera: a camera id or index (\"\": the first)");
-  v.key("role", s.role, OneOf{{"video", "viewfinder", "still", "raw"}}, "libcamera stream role");
+  v.key("role", s.role, kStreamRoleNames, "libcamera stream role");
   v.key("width", s.width, IntRange{0, 16384}, "live: 0 = the camera's first size");
   v.key("height", s.height, IntRange{0, 16384}, "live: 0 = the camera's first size");
   v.key("fps", s.fps, NumberRange::at_least(0), "live: 0 = the camera's default rate");
-  v.key("pixel_format", s.pixel_format, OneOf{{"auto", "YUYV", "NV12", "RGB24", "GREY", "MJPG"}},
+  v.key("pixel_format", s.pixel_format, kCaptureFormatNames,
         "live: MJPG is decoded to RGB24; auto: what the camera offers first");
   // Fewer than 4 starves the driver while one buffer is being converted.
   v.key("buffers", s.buffers, IntRange{4, 32}, "capture buffers");
   v.key("exposure_us", s.exposure_us, IntRange{0, 60'000'000}, "manual exposure; 0 = auto exposure");
   v.key("gain", s.gain, NumberRange::at_least(0), "manual analogue gain (1 = unity); 0 = auto");
   v.key("gain_unity", s.gain_unity, NumberRange::above(0), "v4l2: the gain control value that means gain 1");
-  v.key("timestamp_meaning", s.timestamp_meaning, OneOf{{"auto", "start-of-exposure", "end-of-frame"}},
+  v.key("timestamp_meaning", s.timestamp_meaning, kBufferTimestampsNames,
         "v4l2: what buffer timestamps mean when the driver does not say; auto: the driver's flag");
   v.key("readout_ns", s.readout_ns, IntRange{0, 1'000'000'000}, "rolling-shutter readout time; 0 = global shutter");
   v.key("frame_timeout_ms", s.frame_timeout_ms, IntRange{1, 600'000}, "a frame later than this is a timeout");
@@ -215,11 +220,8 @@ void visit(V& v, SceneObject& s) {
 // Motion blur of the virtual layer (docs/ARCHITECTURE.md, "Motion blur"): how the virtual objects
 // are smeared over each exposure to match the camera's own blur.
 struct BlurConfig {
-  // "off"; "accumulate": full renders spread over the exposure, averaged (the reference);
-  // "seed": seed 000, two renders at 1/4 and 3/4 plus affine-warped samples between them;
-  // "velocity": one render plus a per-pixel velocity gather (fastest).
-  std::string method = "seed";
-  // Samples per frame; 0 chooses them from the frame's image motion (seed: the thesis's rule).
+  BlurMethod method = BlurMethod::IntraframeWarp;  // core/config/blur_method.h
+  // Samples per frame; 0 chooses them from the frame's image motion (intraframe-warp: the thesis's rule).
   int samples = 0;
   // Below this much image motion over the exposure a frame is drawn sharp, at no extra cost.
   double min_motion_px = 0.5;
@@ -231,9 +233,10 @@ struct BlurConfig {
 // rule the value must meet, and the help `arpipe config --defaults` prints (docs/ARCHITECTURE.md, "Adding a config key").
 template <class V>
 void visit(V& v, BlurConfig& s) {
-  v.key("method", s.method, OneOf{{"off", "accumulate", "seed", "velocity"}},
-        "accumulate: N renders (the reference); seed: 2 renders + affine warps; velocity: fastest");
-  // 1024: far beyond what converges (bench blur's reference uses 256); the seed method caps at 50.
+  v.key("method", s.method, kBlurMethodNames,
+        "accumulate: N renders (the reference); intraframe-warp (old name: seed): seed 000's 2 renders + affine "
+        "warps; velocity: fastest");
+  // 1024: far beyond what converges (bench blur's reference uses 256); intraframe-warp caps at 50.
   v.key("samples", s.samples, IntRange{0, 1024}, "0: from the frame's image motion");
   v.key("min_motion_px", s.min_motion_px, NumberRange::closed(0, 1000).in("pixels"),
         "frames with less image motion are drawn sharp");
@@ -242,10 +245,7 @@ void visit(V& v, BlurConfig& s) {
 // Shadows of the virtual objects on themselves and on the real ground (docs/ARCHITECTURE.md,
 // "Light and shadows"): a shadow map from the directional light, filtered by `method`.
 struct ShadowConfig {
-  // "off", "hard" (the seed's binary test), "pcf" (k x k percentage-closer filter), "pcss"
-  // (penumbra from the light's angular size), "vsm" (variance shadow map, float moments), or
-  // "vsm-packed" (the seed's 16-bit moments packed in RGBA8, for GLES 2-class hardware).
-  std::string method = "pcss";
+  ShadowMethod method = ShadowMethod::Pcss;  // core/config/shadow_method.h
   int map_size = 1024;                   // texels across: 256, 512, 1024, 2048 or 4096
   int pcf_kernel = 3;                    // pcf: k x k taps, 1..16 (the seed: 3 real time, 8 for quality)
   int vsm_blur = 7;                      // vsm: Gaussian taps across, odd, 1..31 (the seed: 7)
@@ -263,7 +263,7 @@ struct ShadowConfig {
 // rule the value must meet, and the help `arpipe config --defaults` prints (docs/ARCHITECTURE.md, "Adding a config key").
 template <class V>
 void visit(V& v, ShadowConfig& s) {
-  v.key("method", s.method, OneOf{{"off", "hard", "pcf", "pcss", "vsm", "vsm-packed"}},
+  v.key("method", s.method, kShadowMethodNames,
         "hard: binary; pcf: k x k filter; pcss: penumbra from the light's size; vsm-packed: RGBA8 moments");
   v.key("map_size", s.map_size, OneOfInts{{256, 512, 1024, 2048, 4096}, ""}, "texels across");
   v.key("pcf_kernel", s.pcf_kernel, IntRange{1, 16}, "pcf: k x k taps");
@@ -296,7 +296,7 @@ void visit(V& v, PrtConfig& s) {
 
 struct RenderConfig {
   bool enabled = true;
-  std::vector<SceneObject> objects{SceneObject{}};
+  std::vector<SceneObject> objects;  // none unless the config lists them
   Vec3 light_direction = normalized(Vec3{0.3, -0.4, 1.0});  // world frame, towards the light; unit length
   // 0: the light is infinitely far (a directional light); > 0: a lamp this far from the world
   // origin along light_direction (shadows fan out from it).
@@ -349,7 +349,7 @@ void visit(V& v, RenderConfig& s) {
   v.section("blur", s.blur, "motion blur of the virtual layer over each exposure");
   v.section("shadows", s.shadows, "shadows of the virtual objects, on themselves and on the real ground");
   v.section("prt", s.prt, "precomputed radiance transfer, baked once per mesh (arpipe bake)");
-  v.sections("objects", s.objects, "virtual objects: one [[render.objects]] each, placed in the world (anchor) frame");
+  v.sections("objects", s.objects, "virtual objects: one [[render.objects]] each, placed in the world (anchor) frame; none when absent");
 }
 
 // A light probe sphere beside the anchor (core/light): where it is and what it is made of.
@@ -445,10 +445,7 @@ void visit(V& v, EnvironmentConfig& s) {
 
 // The light stage: where the light comes from.
 struct LightConfig {
-  // "fixed": render.light_direction, light_color and ambient (display-referred, no estimation);
-  // "probe": a light probe sphere in view ([light.probe]); "sun": place and time ([light.sun]);
-  // "environment": an HDR light probe file ([light.environment]).
-  std::string source = "fixed";
+  LightSource source = LightSource::Fixed;  // core/config/light_source.h
   CameraResponse response;               // sRGB
   double smoothing_s = 0.3;              // time constant of the temporal smoothing, [0, 60]
   // The real ground around the anchor, whose brightness gives the light's strength where nothing
@@ -465,7 +462,7 @@ struct LightConfig {
 // rule the value must meet, and the help `arpipe config --defaults` prints (docs/ARCHITECTURE.md, "Adding a config key").
 template <class V>
 void visit(V& v, LightConfig& s) {
-  v.key("source", s.source, OneOf{{"fixed", "probe", "sun", "environment"}},
+  v.key("source", s.source, kLightSourceNames,
         "fixed: render.light_*; probe: a probe sphere in view; sun: place and time; environment: an HDR probe file");
   v.key("response", s.response, CameraResponseName{}, "the camera's response curve");
   v.key("smoothing_s", s.smoothing_s, NumberRange::closed(0, 60).in("s"), "time constant of the temporal smoothing");
@@ -477,7 +474,7 @@ void visit(V& v, LightConfig& s) {
 }
 
 struct PngSinkConfig {
-  bool enabled = true;
+  bool enabled = false;  // on when the config has its table ([sinks.*] below)
   std::filesystem::path dir = "out/png";
   int every = 1;  // write every Nth frame
   int compression = 1;  // OpenCV's own default level (capture/sinks/png_sink.cpp)
@@ -496,7 +493,7 @@ void visit(V& v, PngSinkConfig& s) {
         "not always smaller on camera noise");
 }
 struct Y4mSinkConfig {
-  bool enabled = true;
+  bool enabled = false;  // on when the config has its table ([sinks.*] below)
   std::filesystem::path path = "out/arpiped.y4m";
 
   bool operator==(const Y4mSinkConfig&) const = default;
@@ -510,7 +507,7 @@ void visit(V& v, Y4mSinkConfig& s) {
   v.key("path", s.path, "the video file");
 }
 struct RecordingSinkConfig {
-  bool enabled = false;
+  bool enabled = false;  // on when the config has its table ([sinks.*] below)
   std::filesystem::path path = "out/composited";
 
   bool operator==(const RecordingSinkConfig&) const = default;
@@ -524,7 +521,7 @@ void visit(V& v, RecordingSinkConfig& s) {
   v.key("path", s.path, "the recording directory");
 }
 struct ResultsSinkConfig {
-  bool enabled = true;
+  bool enabled = false;  // on when the config has its table ([sinks.*] below)
   std::filesystem::path path = "out/results.jsonl";  // per-frame pose, tracking state, timings
 
   bool operator==(const ResultsSinkConfig&) const = default;
@@ -550,17 +547,19 @@ struct SinksConfig {
 // Its keys, one row each: the name in the file, the member (whose initializer is the default), the
 // rule the value must meet, and the help `arpipe config --defaults` prints (docs/ARCHITECTURE.md, "Adding a config key").
 template <class V>
+// A sink writes only when the config names it: its table present turns it on (unless it says
+// enabled = false), absent leaves it off.
 void visit(V& v, SinksConfig& s) {
-  v.section("png", s.png, "composited frames as PNG files");
-  v.section("y4m", s.y4m, "composited frames as a Y4M video");
-  v.section("recording", s.recording, "composited frames as a recording");
-  v.section("results", s.results, "per-frame pose, tracking state and timings as JSON lines");
+  v.switched_section("png", s.png, "composited frames as PNG files");
+  v.switched_section("y4m", s.y4m, "composited frames as a Y4M video");
+  v.switched_section("recording", s.recording, "composited frames as a recording");
+  v.switched_section("results", s.results, "per-frame pose, tracking state and timings as JSON lines");
 }
 
 struct PipelineConfig {
   int queue_depth = 4;
   int64_t max_frames = 0;  // 0 = no limit
-  std::string log_level = "info";
+  log::Level log_level = log::Level::Info;
 
   bool operator==(const PipelineConfig&) const = default;
 };
@@ -571,7 +570,7 @@ template <class V>
 void visit(V& v, PipelineConfig& s) {
   v.key("queue_depth", s.queue_depth, IntRange{1}, "frames between threads");
   v.key("max_frames", s.max_frames, IntRange{0}, "stop after this many frames; 0 = no limit");
-  v.key("log_level", s.log_level, OneOf{{"error", "warning", "info", "debug"}}, "what the daemon logs");
+  v.key("log_level", s.log_level, kLogLevelNames, "what the daemon logs");
 }
 
 struct Config {

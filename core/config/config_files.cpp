@@ -50,7 +50,7 @@ void check_recording_dir(const Config& config, const fs::path& dir) {
 }  // namespace
 
 void check_config_files(const Config& config) {
-  if (config.source.type == "replay") check_recording_dir(config, config.source.path);
+  if (config.source.type == SourceType::Replay) check_recording_dir(config, config.source.path);
   if (!config.source.camera_model.empty())
     check_regular_file(config, "source.camera_model", config.source.camera_model, "camera model");
   if (config.render.enabled)
@@ -59,7 +59,7 @@ void check_config_files(const Config& config) {
       if (!is_builtin_mesh_source(mesh))
         check_regular_file(config, fmt::format("render.objects[{}].mesh", i), mesh, "glTF mesh");
     }
-  if (config.light.source == "environment" || !config.light.environment.file.empty())
+  if (config.light.source == LightSource::Environment || !config.light.environment.file.empty())
     check_regular_file(config, "light.environment.file", config.light.environment.file, "HDR environment");
 }
 

@@ -60,7 +60,7 @@ void check_cross_keys(const TomlSection& t, ShadowConfig& s) {
 }
 
 void check_cross_keys(const TomlSection& t, LightConfig& s) {
-  if (s.source == "environment" && s.environment.file.empty())
+  if (s.source == LightSource::Environment && s.environment.file.empty())
     t.fail_with("source", "expected light.environment.file to be set when the source is \"environment\"");
 }
 
@@ -140,6 +140,14 @@ class RowReader {
   template <class Section>
   void section(std::string_view name, Section& member, std::string_view) {
     if (const auto sub = t_.section(name)) read_section(*sub, member);
+  }
+  // A table whose presence turns its part on (a sink): `enabled` is true unless the table says not.
+  template <class Section>
+  void switched_section(std::string_view name, Section& member, std::string_view) {
+    if (const auto sub = t_.section(name)) {
+      member.enabled = true;
+      read_section(*sub, member);
+    }
   }
   template <class Element>
   void sections(std::string_view name, std::vector<Element>& member, std::string_view) {

@@ -31,7 +31,7 @@ struct EnvironmentAssets final : StageAssets {
 StageAssetLoader LightStage::asset_loader() const {
   return [](const Config& config) -> std::shared_ptr<const StageAssets> {
     auto assets = std::make_shared<EnvironmentAssets>();
-    if (config.light.source == "environment") assets->environment = load_environment_lighting(config).estimate;
+    if (config.light.source == LightSource::Environment) assets->environment = load_environment_lighting(config).estimate;
     return assets;
   };
 }
@@ -46,9 +46,7 @@ void LightStage::configure_loaded(const Config& config, const std::shared_ptr<co
   std::unique_ptr<ProbeLightEstimator> probe;
   std::unique_ptr<SunLight> sun;
   LightEstimate environment;
-  Source source = Source::Fixed;
-  if (light.source == "probe") {
-    source = Source::Probe;
+  if (light.source == LightSource::Probe) {
     ProbeLightConfig c;
     c.sphere.kind = light.probe.kind == "diffuse" ? ProbeSphere::Kind::Diffuse : ProbeSphere::Kind::Mirror;
     c.sphere.center_world = light.probe.center_m;
@@ -65,19 +63,17 @@ void LightStage::configure_loaded(const Config& config, const std::shared_ptr<co
     } catch (const std::exception& e) {
       throw ConfigError(fmt::format("{}: [light.probe]: {}", config.file.string(), e.what()));
     }
-  } else if (light.source == "sun") {
-    source = Source::Sun;
+  } else if (light.source == LightSource::Sun) {
     sun = std::make_unique<SunLight>();
     sun->configure(light.sun, light.ground_albedo, response, light.smoothing_s, config.file);
-  } else if (light.source == "environment") {
-    source = Source::Environment;
+  } else if (light.source == LightSource::Environment) {
     if (!loaded->environment) throw std::logic_error("LightStage::configure_loaded: the environment was not loaded");
     environment = *loaded->environment;
     log::info("light: environment {} ({}), ambient L00 = ({:.4g}, {:.4g}, {:.4g})", light.environment.file.string(),
               light.environment.layout, environment.ambient_sh[0][0], environment.ambient_sh[0][1],
               environment.ambient_sh[0][2]);
   }
-  source_ = source;
+  source_ = light.source;
   probe_ = std::move(probe);
   sun_ = std::move(sun);
   environment_ = std::move(environment);
@@ -90,11 +86,11 @@ void LightStage::configure_loaded(const Config& config, const std::shared_ptr<co
 
 void LightStage::process(FrameContext& ctx) noexcept {
   const auto start = std::chrono::steady_clock::now();
-  if (source_ == Source::Fixed) {
+  if (source_ == LightSource::Fixed) {
     ctx.record_timing(std::string(name()), milliseconds_since(start), "fixed light (render.light_*)");
     return;
   }
-  if (source_ == Source::Environment) {
+  if (source_ == LightSource::Environment) {
     ctx.light = environment_;
     ctx.record_timing(std::string(name()), milliseconds_since(start), "environment file (static)");
     return;
@@ -104,7 +100,7 @@ void LightStage::process(FrameContext& ctx) noexcept {
     ctx.record_timing(std::string(name()), milliseconds_since(start), "no camera model");
     return;
   }
-  if (source_ == Source::Probe) {
+  if (source_ == LightSource::Probe) {
     ctx.light = probe_->update(ctx.camera, *ctx.camera_model, ctx.pose.T_cam_world, pose_valid);
     const ProbeDiagnostics& diag = probe_->diagnostics();
     if (diag.measured && !ctx.light.lights.empty() && !diag.light_clipped.empty() && diag.light_clipped.front()) {

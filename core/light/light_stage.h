@@ -7,6 +7,7 @@
 #include <memory>
 #include <string>
 
+#include "core/config/light_source.h"
 #include "core/light/ground_radiance.h"
 #include "core/probe/probe_light_estimator.h"
 #include "core/sun/sun_light.h"
@@ -29,8 +30,7 @@ class LightStage final : public Stage {
   void process(FrameContext& ctx) noexcept override;
 
  private:
-  enum class Source { Fixed, Probe, Sun, Environment };
-  Source source_ = Source::Fixed;
+  LightSource source_ = LightSource::Fixed;
   std::unique_ptr<ProbeLightEstimator> probe_;
   std::unique_ptr<SunLight> sun_;
   LightEstimate environment_;  // Environment: the same every frame

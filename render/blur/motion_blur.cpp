@@ -42,30 +42,12 @@ std::vector<ObjectAtInstant> objects_at(const LayerDrawRequest& request, double 
 
 }  // namespace
 
-BlurMethod parse_blur_method(std::string_view name) {
-  if (name == "off") return BlurMethod::Off;
-  if (name == "accumulate") return BlurMethod::Accumulate;
-  if (name == "seed") return BlurMethod::Seed;
-  if (name == "velocity") return BlurMethod::Velocity;
-  throw ConfigError(fmt::format("render.blur.method: expected \"off\", \"accumulate\", \"seed\" or \"velocity\", got \"{}\"", name));
-}
-
-std::string_view blur_method_name(BlurMethod method) {
-  switch (method) {
-    case BlurMethod::Off: return "off";
-    case BlurMethod::Accumulate: return "accumulate";
-    case BlurMethod::Seed: return "seed";
-    case BlurMethod::Velocity: return "velocity";
-  }
-  return "?";
-}
-
 MotionBlurDrawer::MotionBlurDrawer(const EglContext& context, GLenum layer_format)
     : context_(context), layer_format_(layer_format) {}
 
 void MotionBlurDrawer::prepare(BlurMethod method) {
   if (method == BlurMethod::Accumulate && !accumulation_) accumulation_ = std::make_unique<AccumulationPass>(context_);
-  if (method == BlurMethod::Seed && !seed_) seed_ = std::make_unique<IntraframeWarpBlurPass>(layer_format_);
+  if (method == BlurMethod::IntraframeWarp && !seed_) seed_ = std::make_unique<IntraframeWarpBlurPass>(layer_format_);
   if (method == BlurMethod::Velocity && !velocity_) velocity_ = std::make_unique<VelocityBlurPass>(layer_format_);
 }
 
@@ -78,7 +60,7 @@ void MotionBlurDrawer::draw_at(VirtualLayer& layer, const LayerDrawRequest& requ
 
 LayerDrawResult MotionBlurDrawer::draw(VirtualLayer& layer, const LayerDrawRequest& request, const BlurConfig& config) {
   layer.ensure(request.lens.width, request.lens.height, request.msaa_samples);
-  const BlurMethod method = parse_blur_method(config.method);
+  const BlurMethod method = config.method;
   LayerDrawResult result;
   if (method != BlurMethod::Off) {
     if (!request.motion || !request.motion->valid()) result.sharp_because = "no motion estimate";
@@ -91,7 +73,7 @@ LayerDrawResult MotionBlurDrawer::draw(VirtualLayer& layer, const LayerDrawReque
         return draw_accumulated(layer, request,
                                 config.samples > 0 ? config.samples
                                                    : samples_for_motion(request.image_motion_px, 2, kMaxAutoAccumulateSamples));
-      case BlurMethod::Seed: return draw_intraframe_warp(layer, request, config.samples);
+      case BlurMethod::IntraframeWarp: return draw_intraframe_warp(layer, request, config.samples);
       case BlurMethod::Velocity:
         return draw_velocity(layer, request,
                              config.samples > 0 ? std::min(config.samples, VelocityBlurPass::kMaxSamples)
@@ -136,7 +118,7 @@ LayerDrawResult MotionBlurDrawer::draw_intraframe_warp(VirtualLayer& layer, cons
   first_intraframe_.copy_from(layer.resolved_framebuffer(), request.rect);
   draw_at(layer, request, kSecondIntraframe);
   seed_->run(first_intraframe_.texture(), layer.texture(), layer.width(), layer.height(), plan, request.rect);
-  return {seed_->texture(), BlurMethod::Seed, static_cast<int>(plan.samples.size()), {}};
+  return {seed_->texture(), BlurMethod::IntraframeWarp, static_cast<int>(plan.samples.size()), {}};
 }
 
 LayerDrawResult MotionBlurDrawer::draw_velocity(VirtualLayer& layer, const LayerDrawRequest& request, int samples) {

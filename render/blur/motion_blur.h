@@ -21,9 +21,6 @@
 
 namespace arpipe {
 
-enum class BlurMethod { Off, Accumulate, Seed, Velocity };
-BlurMethod parse_blur_method(std::string_view name);  // as render.blur.method; throws ConfigError
-std::string_view blur_method_name(BlurMethod method);
 
 // What one frame's draw needs, in the coordinates of the canvas drawn on (the lens image, or the
 // pinhole canvas with render.lens = "map").

@@ -166,7 +166,7 @@ void check_complete(const char* what) {
 }  // namespace
 
 ShadowMapPass::ShadowMapPass(const EglContext& context, const ShadowConfig& config)
-    : config_(config), method_(parse_shadow_method(config.method)), empty_vertex_array_(GlVertexArray::create()) {
+    : config_(config), method_(config.method), empty_vertex_array_(GlVertexArray::create()) {
   if (method_ == ShadowMethod::Off) return;
   const int size = config.map_size;
   framebuffer_ = GlFramebuffer::create();

@@ -32,7 +32,7 @@ TEST(EnvironmentSpecular, ReflectsTheSkyAlongTheMirrorDirection) {
   config.render.objects[0].prt = "off";
   config.render.objects[0].specular = specular;
   config.render.msaa_samples = 0;
-  config.render.shadows.method = "off";
+  config.render.shadows.method = ShadowMethod::Off;
   harness().configure(config);
   const Vec3 eye{0.22, -0.33, 0.30};
   const SE3 pose = look_at(eye, {0.01, 0.0, 0.05});

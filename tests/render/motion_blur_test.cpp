@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,7 +22,7 @@ using namespace render_test;
 constexpr int kWidth = 320, kHeight = 240;
 constexpr double kFx = 300.0;
 constexpr int64_t kExposureNs = 10'000'000;
-const std::vector<std::string> kBlurMethods{"accumulate", "seed", "velocity"};
+const std::vector<std::string> kBlurMethods{"accumulate", "intraframe-warp", "velocity"};
 
 Config white_cube_config(const std::string& blur_method, int samples = 0, double min_motion_px = 0.5) {
   Config config;
@@ -31,7 +32,9 @@ Config white_cube_config(const std::string& blur_method, int samples = 0, double
   config.render.objects[0].color = {1, 1, 1};
   config.render.ambient = {1, 1, 1};  // unlit: premultiplied colour = alpha
   config.render.light_color = {0, 0, 0};
-  config.render.blur.method = blur_method;
+  const std::optional<BlurMethod> method = choice_value(kBlurMethodNames, blur_method);
+  EXPECT_TRUE(method.has_value()) << blur_method;
+  config.render.blur.method = method.value_or(BlurMethod::Off);
   config.render.blur.samples = samples;
   config.render.blur.min_motion_px = min_motion_px;
   return config;
@@ -184,7 +187,7 @@ TEST_P(BlurWidth, MatchesThePredictedImageMotion) {
   const std::vector<double> sharp = alpha_of(run(white_cube_config("off"), motion));
   const FrameContext ctx = run(white_cube_config(method), motion);
   ASSERT_EQ(ctx.blur_method, method);
-  EXPECT_GE(ctx.blur_samples, method == "seed" ? int(std::lround(shift_px)) : int(std::ceil(shift_px)));
+  EXPECT_GE(ctx.blur_samples, method == "intraframe-warp" ? int(std::lround(shift_px)) : int(std::ceil(shift_px)));
   const std::vector<double> blurred = alpha_of(ctx);
   const int y = kHeight / 2;
   const std::vector<double> sharp_row = row_of(sharp, y);
@@ -203,16 +206,16 @@ TEST_P(BlurWidth, MatchesThePredictedImageMotion) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Methods, BlurWidth,
-                         ::testing::Combine(::testing::Values("accumulate", "seed", "velocity"),
+                         ::testing::Combine(::testing::Values("accumulate", "intraframe-warp", "velocity"),
                                             ::testing::Values(6.0, 24.0)));
 
 TEST(MotionBlur, SkippedBelowTheThresholdAndReportedAbove) {
   const ShutterMotion slow = pan_motion(overhead_pose(), 0.3 / kFx);
-  const FrameContext ctx_slow = run(white_cube_config("seed"), slow);
+  const FrameContext ctx_slow = run(white_cube_config("intraframe-warp"), slow);
   EXPECT_EQ(ctx_slow.blur_method, "off");
   const ShutterMotion fast = pan_motion(overhead_pose(), 10.0 / kFx);
-  const FrameContext ctx_fast = run(white_cube_config("seed"), fast);
-  EXPECT_EQ(ctx_fast.blur_method, "seed");
+  const FrameContext ctx_fast = run(white_cube_config("intraframe-warp"), fast);
+  EXPECT_EQ(ctx_fast.blur_method, "intraframe-warp");
   EXPECT_EQ(ctx_fast.blur_samples, 12) << "the thesis's rule: round(D) + 2 with D = 10 px";
 }
 
@@ -273,14 +276,14 @@ TEST(MotionBlur, HugeAndTinyMotionsStayBounded) {
 
 TEST(MotionBlur, APredictedPoseIsDrawnAndBlurred) {
   const ShutterMotion motion = pan_motion(overhead_pose(), 12.0 / kFx);
-  harness().configure(white_cube_config("seed"));
+  harness().configure(white_cube_config("intraframe-warp"));
   FrameContext ctx = make_context(black_frame(), pinhole_camera(), motion.T_cam_world_mid, TrackState::Predicted);
   ctx.motion = motion;
   ctx.motion.max_image_motion_px = 12.0;
   ctx.pose.predicted_uncertainty_deg = 2.0;  // within the default render.max_predicted_uncertainty_deg (5)
   harness().stages.process(ctx);
   EXPECT_TRUE(ctx.virtual_layer_drawn);
-  EXPECT_EQ(ctx.blur_method, "seed");
+  EXPECT_EQ(ctx.blur_method, "intraframe-warp");
 
   // Past the bound the object would stand visibly in the wrong place: not drawn, and said why.
   FrameContext uncertain = make_context(black_frame(), pinhole_camera(), motion.T_cam_world_mid, TrackState::Predicted);

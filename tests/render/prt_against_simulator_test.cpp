@@ -95,8 +95,8 @@ Config object_config(const std::string& mesh, const std::string& prt) {
   config.render.prt.samples = 24;
   config.render.prt.cache_dir = fs::path(ARPIPE_BINARY_DIR) / "test-cache" / "prt-simulator-test";
   config.render.msaa_samples = 0;
-  config.render.shadows.method = "off";
-  config.light.source = "environment";
+  config.render.shadows.method = ShadowMethod::Off;
+  config.light.source = LightSource::Environment;
   config.light.environment.file = sky_files().pipeline;
   config.light.environment.layout = "equirect";
   return config;

@@ -38,8 +38,8 @@ void expect_error(const std::string& text, const std::vector<std::string>& fragm
 
 TEST(Config, DefaultsAreTheDocumentedOnes) {
   const Config c;
-  EXPECT_EQ(c.source.type, "replay");
-  EXPECT_EQ(c.source.pacing, "timestamps");
+  EXPECT_EQ(c.source.type, SourceType::Replay);
+  EXPECT_EQ(c.source.pacing, ReplayPacing::Timestamps);
   EXPECT_EQ(c.track.family, "tag36h11");
   ASSERT_EQ(c.track.bundle.size(), 1u);
   EXPECT_EQ(c.track.bundle[0].id, 0);
@@ -48,7 +48,7 @@ TEST(Config, DefaultsAreTheDocumentedOnes) {
   EXPECT_EQ(c.render.lens, LensMode::Map);
   EXPECT_EQ(c.render.lens_canvas_scale, 1.5);
   EXPECT_EQ(c.pipeline.queue_depth, 4);
-  EXPECT_EQ(c.pipeline.log_level, "info");
+  EXPECT_EQ(c.pipeline.log_level, log::Level::Info);
   // The default light direction is (0.3, -0.4, 1) made unit length.
   EXPECT_NEAR(norm(c.render.light_direction), 1.0, 1e-15);
   EXPECT_NEAR(c.render.light_direction[0] / c.render.light_direction[2], 0.3, 1e-15);
@@ -151,7 +151,7 @@ log_level = "debug"
   const Config c = parse_config(text, "full.toml");
   EXPECT_EQ(c.file, "full.toml");
   EXPECT_EQ(c.source.path, "rec/one");
-  EXPECT_EQ(c.source.pacing, "fast");
+  EXPECT_EQ(c.source.pacing, ReplayPacing::Fast);
   EXPECT_TRUE(c.source.loop);
   EXPECT_EQ(c.source.timestamp_offset_ns, -1500000);
   EXPECT_EQ(c.source.camera_model, "cam.cameramodel");
@@ -197,7 +197,29 @@ log_level = "debug"
   EXPECT_EQ(c.sinks.results.path, "o/r.jsonl");
   EXPECT_EQ(c.pipeline.queue_depth, 8);
   EXPECT_EQ(c.pipeline.max_frames, 1000);
-  EXPECT_EQ(c.pipeline.log_level, "debug");
+  EXPECT_EQ(c.pipeline.log_level, log::Level::Debug);
+}
+
+// The live cameras' choice keys read through their name tables into the capture code's enums.
+TEST(Config, LiveSourceChoicesReadIntoTheirEnums) {
+  const Config defaults;
+  EXPECT_EQ(defaults.source.role, StreamRole::Video);
+  EXPECT_EQ(defaults.source.pixel_format, CaptureFormat::Auto);
+  EXPECT_EQ(defaults.source.timestamp_meaning, BufferTimestamps::DriverFlag);
+  const Config v4l2 = parse_config(
+      "[source]\ntype = \"v4l2\"\npixel_format = \"MJPG\"\ntimestamp_meaning = \"start-of-exposure\"\n", "v.toml");
+  EXPECT_EQ(v4l2.source.type, SourceType::V4l2);
+  EXPECT_EQ(v4l2.source.pixel_format, CaptureFormat::MJPG);
+  EXPECT_EQ(v4l2.source.timestamp_meaning, BufferTimestamps::StartOfExposure);
+  const Config libcamera = parse_config(
+      "[source]\ntype = \"libcamera\"\nrole = \"still\"\npixel_format = \"NV12\"\ntimestamp_meaning = \"end-of-frame\"\n"
+      "[pipeline]\nlog_level = \"warning\"\n",
+      "l.toml");
+  EXPECT_EQ(libcamera.source.type, SourceType::Libcamera);
+  EXPECT_EQ(libcamera.source.role, StreamRole::Still);
+  EXPECT_EQ(libcamera.source.pixel_format, CaptureFormat::NV12);
+  EXPECT_EQ(libcamera.source.timestamp_meaning, BufferTimestamps::EndOfFrame);
+  EXPECT_EQ(libcamera.pipeline.log_level, log::Level::Warning);
 }
 
 TEST(Config, InlineArrayOfTablesIsTheSameAsArrayOfTables) {
@@ -361,7 +383,7 @@ TEST(Config, OverridesReplaceKeysBeforeValidation) {
                                  "sinks.png.dir=out/run1", "render.ambient=[0.5, 0.5, 0.5]", "render.lens=vertex"});
   EXPECT_EQ(c.pipeline.queue_depth, 3);
   EXPECT_EQ(c.track.family, "tag25h9");
-  EXPECT_EQ(c.source.pacing, "fast");  // a bare word is a string
+  EXPECT_EQ(c.source.pacing, ReplayPacing::Fast);  // a bare word is a string
   ASSERT_EQ(c.render.objects.size(), 2u);
   EXPECT_EQ(c.render.objects[0].scale, 2.0);
   EXPECT_EQ(c.render.objects[0].position_m, (Vec3{1, 2, 3}));
@@ -443,7 +465,7 @@ namespace {
 
 TEST(Config, BlurKeysHaveTheirDefaultsAndReadBack) {
   const Config d;
-  EXPECT_EQ(d.render.blur.method, "seed");
+  EXPECT_EQ(d.render.blur.method, BlurMethod::IntraframeWarp);
   EXPECT_EQ(d.render.blur.samples, 0);
   EXPECT_EQ(d.render.blur.min_motion_px, 0.5);
   EXPECT_TRUE(d.render.rolling_shutter);
@@ -452,15 +474,19 @@ TEST(Config, BlurKeysHaveTheirDefaultsAndReadBack) {
       "[render]\nrolling_shutter = false\nmax_predicted_uncertainty_deg = 12\n[render.blur]\nmethod = \"velocity\"\nsamples = 16\nmin_motion_px = 2\n", "b.toml");
   EXPECT_FALSE(c.render.rolling_shutter);
   EXPECT_EQ(c.render.max_predicted_uncertainty_deg, 12.0);
-  EXPECT_EQ(c.render.blur.method, "velocity");
+  EXPECT_EQ(c.render.blur.method, BlurMethod::Velocity);
   EXPECT_EQ(c.render.blur.samples, 16);
   EXPECT_EQ(c.render.blur.min_motion_px, 2.0);
-  EXPECT_EQ(parse_config("", "b.toml", {"render.blur.method=accumulate"}).render.blur.method, "accumulate");
+  EXPECT_EQ(parse_config("", "b.toml", {"render.blur.method=accumulate"}).render.blur.method, BlurMethod::Accumulate);
+  // The old name of intraframe-warp (seed 000's method) is still read; the new name is written.
+  EXPECT_EQ(parse_config("[render.blur]\nmethod = \"seed\"\n", "b.toml").render.blur.method, BlurMethod::IntraframeWarp);
+  EXPECT_EQ(parse_config("", "b.toml", {"render.blur.method=seed"}).render.blur.method, BlurMethod::IntraframeWarp);
+  EXPECT_EQ(blur_method_name(BlurMethod::IntraframeWarp), "intraframe-warp");
 }
 
 TEST(Config, BlurValuesOutOfRangeAreRefusedNamingFileAndKey) {
   expect_error("[render.blur]\nmethod = \"fast\"\n",
-               {"test.toml:2:", "render.blur.method: expected one of \"off\", \"accumulate\", \"seed\", \"velocity\""});
+               {"test.toml:2:", "render.blur.method: expected one of \"off\", \"accumulate\", \"intraframe-warp\", \"velocity\""});
   expect_error("[render.blur]\nsamples = -1\n", {"test.toml:2:", "render.blur.samples:", "found -1"});
   expect_error("[render.blur]\nsamples = 2000\n", {"render.blur.samples:", "found 2000"});
   expect_error("[render.blur]\nmin_motion_px = -0.5\n", {"render.blur.min_motion_px:", "found -0.5"});
@@ -482,7 +508,7 @@ TEST(Config, EnvironmentAndPrtKeysHaveTheirDefaultsAndReadBack) {
       "yaw_deg = 90\nscale = 2.5\nwindow = \"hanning\"\n[render.prt]\nsamples = 40\nbands = 5\ncache_dir = \"c\"\n"
       "[[render.objects]]\nmesh = \"builtin:cup\"\nprt = \"interreflected\"\n",
       "e.toml");
-  EXPECT_EQ(c.light.source, "environment");
+  EXPECT_EQ(c.light.source, LightSource::Environment);
   EXPECT_EQ(c.light.environment.file, fs::path("probe.exr"));
   EXPECT_EQ(c.light.environment.layout, "angular");
   EXPECT_NEAR(c.light.environment.yaw_rad, kPi / 2, 1e-15);
