@@ -65,9 +65,9 @@ void load_standin(const fs::path& dir, const fs::path& recording, const std::str
     throw std::runtime_error(fmt::format("stand-in: {}", error));
 }
 
-SourceConfig source_config(const std::string& format) {
+SourceConfig source_config(CaptureFormat format) {
   SourceConfig c;
-  c.type = "v4l2";
+  c.type = SourceType::V4l2;
   c.device = kDevice;
   c.pixel_format = format;
   return c;
@@ -100,9 +100,11 @@ long minor_faults() {
   return usage.ru_minflt;
 }
 
-Row measure(const fs::path& dir, const fs::path& recording, const std::string& camera_format, int frames) {
-  load_standin(dir, recording, fmt::format("pacing = \"fast\"\nformats = [\"{}\"]\nloop = true", camera_format));
-  auto source = make_live_source(source_config(camera_format == "native" ? "auto" : camera_format));
+// The stand-in sends `camera_format` and the source asks for it by the same name.
+Row measure(const fs::path& dir, const fs::path& recording, CaptureFormat camera_format, int frames) {
+  load_standin(dir, recording, fmt::format("pacing = \"fast\"\nformats = [\"{}\"]\nloop = true",
+                                           choice_name(kCaptureFormatNames, camera_format)));
+  auto source = make_live_source(source_config(camera_format));
   BoundedQueue<Frame> queue(4, OverflowPolicy::DropOldest);
   Row row;
   row.format = source->format().camera_format;
@@ -138,7 +140,7 @@ Row measure(const fs::path& dir, const fs::path& recording, const std::string& c
 // Real-time pacing with live timestamps: each frame falls due at its exposure end, on this clock.
 std::vector<double> latencies_ms(const fs::path& dir, const fs::path& recording, int frames) {
   load_standin(dir, recording, "pacing = \"realtime\"\ntimestamps = \"live\"\ntimestamp_source = \"eof\"\nloop = true");
-  auto source = make_live_source(source_config("auto"));
+  auto source = make_live_source(source_config(CaptureFormat::Auto));
   std::vector<double> ms;
   while (int(ms.size()) < frames) {
     Frame frame;
@@ -198,7 +200,8 @@ int run_capture_path_benchmark(const CapturePathOptions& options) {
                reader.info().width, reader.info().height, pixel_format_name(reader.info().pixel_format), frames);
     fmt::print("| camera sends | frame bytes | DQBUF+QBUF µs | copy/decode µs | hand-off µs | memcpy µs | "
                "(copy/decode + hand-off) / memcpy | page faults/frame |\n|---|---:|---:|---:|---:|---:|---:|---:|\n");
-    for (const char* format : {"YUYV", "GREY", "RGB24", "NV12", "MJPG"}) {
+    for (const CaptureFormat format : {CaptureFormat::YUYV, CaptureFormat::GREY, CaptureFormat::RGB24,
+                                       CaptureFormat::NV12, CaptureFormat::MJPG}) {
       const Row r = measure(dir, recording, format, frames);
       fmt::print("| {} | {} | {:.1f} | {:.1f} | {:.2f} | {:.1f} | {:.2f} | {:.0f} |\n", r.format, r.frame_bytes,
                  r.dequeue_us, r.convert_us, r.handoff_us, r.memcpy_us, (r.convert_us + r.handoff_us) / r.memcpy_us,

@@ -63,9 +63,7 @@ struct ReplaySource::Impl {
 
 ReplaySource::ReplaySource(const SourceConfig& config) : impl_(std::make_unique<Impl>(config)) {
   Impl& s = *impl_;
-  if (config.pacing != "timestamps" && config.pacing != "fast")
-    throw ConfigError(fmt::format("source.pacing is \"{}\", expected \"timestamps\" or \"fast\"", config.pacing));
-  s.paced = config.pacing == "timestamps";
+  s.paced = config.pacing == ReplayPacing::Timestamps;
   const RecordingInfo& info = s.reader.info();
   if (config.camera_model.empty()) {
     s.model = std::make_shared<const CameraModel>(s.reader.camera_model());
@@ -116,7 +114,8 @@ std::string ReplaySource::describe() const {
   const Impl& s = *impl_;
   const RecordingInfo& info = s.reader.info();
   return fmt::format("replay:{} ({} frames, {}x{} {}, pacing {}{})", s.config.path.string(), s.reader.frame_count(),
-                     info.width, info.height, pixel_format_name(info.pixel_format), s.config.pacing,
+                     info.width, info.height, pixel_format_name(info.pixel_format),
+                     choice_name(kReplayPacingNames, s.config.pacing),
                      s.config.loop ? ", loop" : "");
 }
 

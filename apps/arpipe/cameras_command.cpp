@@ -18,8 +18,8 @@ namespace arpipe {
 namespace {
 
 void print(const CameraDescription& camera) {
-  const std::string key = camera.backend == "v4l2" ? "source.device" : "source.camera";
-  fmt::print("{}: {}  ({} = \"{}\")\n", camera.backend, camera.name.empty() ? "(unnamed)" : camera.name, key,
+  const std::string key = camera.backend == SourceType::V4l2 ? "source.device" : "source.camera";
+  fmt::print("{}: {}  ({} = \"{}\")\n", choice_name(kSourceTypeNames, camera.backend), camera.name.empty() ? "(unnamed)" : camera.name, key,
              camera.id);
   if (!camera.location.empty()) fmt::print("  location: {}\n", camera.location);
   if (!camera.error.empty()) fmt::print("  note: {}\n", camera.error);

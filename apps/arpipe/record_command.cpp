@@ -26,13 +26,14 @@ void on_signal(int) { g_stop = true; }
 // The --camera argument as config overrides.
 bool camera_overrides(const std::string& camera, std::vector<std::string>& overrides) {
   if (camera.starts_with("libcamera:")) {
-    overrides.push_back("source.type=\"libcamera\"");
+    overrides.push_back("source.type=" +
+                        toml_string(std::string(choice_name(kSourceTypeNames, SourceType::Libcamera))));
     overrides.push_back("source.camera=" + toml_string(camera.substr(10)));
     return true;
   }
   const std::string path = camera.starts_with("v4l2:") ? camera.substr(5) : camera;
   if (path.empty()) return false;
-  overrides.push_back("source.type=\"v4l2\"");
+  overrides.push_back("source.type=" + toml_string(std::string(choice_name(kSourceTypeNames, SourceType::V4l2))));
   overrides.push_back("source.device=" + toml_string(path));
   return true;
 }

@@ -25,8 +25,9 @@ int replay(ReplayOptions options) {
   const std::string& config_path = options.config_path;
   std::vector<std::string>& overrides = options.overrides;
   // The recording and "as fast as possible" come last, so they win over the file.
-  overrides.push_back("source.type=\"replay\"");
-  overrides.push_back("source.pacing=\"fast\"");
+  overrides.push_back("source.type=" + toml_string(std::string(choice_name(kSourceTypeNames, SourceType::Replay))));
+  overrides.push_back("source.pacing=" +
+                      toml_string(std::string(choice_name(kReplayPacingNames, ReplayPacing::Fast))));
   overrides.push_back(fmt::format("source.path={}", toml_string(dir)));
   const Config config = config_path.empty() ? parse_config("", "(defaults)", overrides)
                                             : load_config(config_path, overrides);

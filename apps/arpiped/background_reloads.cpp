@@ -12,7 +12,6 @@
 #include <thread>
 #include <vector>
 
-#include "apps/arpiped/log_level.h"
 #include "apps/arpiped/reload_changes.h"
 #include "core/log.h"
 #include "core/pipeline/pipeline_runner.h"
@@ -75,7 +74,7 @@ void BackgroundReloads::reload(const std::shared_ptr<Shared>& s, uint64_t ticket
       accepted = s->reloader->reconfigure(ticket, next, error, PipelineRunner::kReconfigureBoundaryTimeout, &replaced);
       if (accepted) {
         applied = changed_parts(replaced, next);
-        log::set_max_level(log_level_from_name(next.pipeline.log_level));
+        log::set_max_level(next.pipeline.log_level);
       }
     }
   } catch (const std::exception& e) {

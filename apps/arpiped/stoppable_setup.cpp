@@ -9,7 +9,6 @@
 #include <string>
 #include <thread>
 
-#include "apps/arpiped/log_level.h"
 #include "apps/common/pipeline_assembly.h"
 #include "core/log.h"
 
@@ -31,7 +30,7 @@ struct SetupState {
 void set_up(const DaemonOptions& options, SetupState& state) {
   try {
     state.config = load_config(options.config_path, options.overrides);
-    log::set_max_level(log_level_from_name(state.config.pipeline.log_level));
+    log::set_max_level(state.config.pipeline.log_level);
     state.step = "opening the source";
     auto runner = assemble_pipeline(state.config);
     state.step = "loading the assets, configuring the stages and opening the outputs";

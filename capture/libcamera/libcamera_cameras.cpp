@@ -27,7 +27,7 @@ std::string location_name(int32_t location) {
 
 CameraDescription describe(libcamera::Camera& camera) {
   CameraDescription d;
-  d.backend = "libcamera";
+  d.backend = SourceType::Libcamera;
   d.id = camera.id();
   const auto& props = camera.properties();
   if (auto model = props.get(libcamera::properties::Model)) d.name = *model;
@@ -82,7 +82,7 @@ std::vector<CameraDescription> list_libcamera_cameras() {
     manager = &libcamera_manager();
   } catch (const CameraError& e) {
     CameraDescription d;
-    d.backend = "libcamera";
+    d.backend = SourceType::Libcamera;
     d.error = e.what();
     out.push_back(d);
     return out;

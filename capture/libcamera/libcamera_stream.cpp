@@ -34,12 +34,14 @@ namespace {
 
 using Kind = CameraError::Kind;
 
-std::optional<libcamera::StreamRole> stream_role(const std::string& name) {
-  if (name == "video") return libcamera::StreamRole::VideoRecording;
-  if (name == "viewfinder") return libcamera::StreamRole::Viewfinder;
-  if (name == "still") return libcamera::StreamRole::StillCapture;
-  if (name == "raw") return libcamera::StreamRole::Raw;
-  return std::nullopt;
+libcamera::StreamRole stream_role(StreamRole role) {
+  switch (role) {
+    case StreamRole::Video: return libcamera::StreamRole::VideoRecording;
+    case StreamRole::Viewfinder: return libcamera::StreamRole::Viewfinder;
+    case StreamRole::Still: return libcamera::StreamRole::StillCapture;
+    case StreamRole::Raw: return libcamera::StreamRole::Raw;
+  }
+  return libcamera::StreamRole::VideoRecording;
 }
 
 bool all_digits(const std::string& s) {
@@ -195,27 +197,24 @@ void LibcameraStream::open(const SourceConfig& config) {
 }
 
 void LibcameraStream::configure(const SourceConfig& config) {
-  auto role = stream_role(config.role);
-  if (!role)
-    throw CameraError(Kind::Refused, fmt::format("libcamera camera '{}': unknown stream role '{}' (video, viewfinder, "
-                                                 "still or raw)",
-                                                 camera_id_, config.role));
+  const std::string_view role_name = choice_name(kStreamRoleNames, config.role);
   // A braced list: libcamera 0.0.x takes a StreamRoles vector, 0.1 and later a Span or an
   // initializer_list; this spelling compiles against both.
-  camera_config_ = camera_->generateConfiguration({*role});
+  camera_config_ = camera_->generateConfiguration({stream_role(config.role)});
   if (!camera_config_ || camera_config_->size() != 1)
     throw CameraError(Kind::Refused,
-                      fmt::format("libcamera camera '{}': no configuration for the {} role", camera_id_, config.role));
+                      fmt::format("libcamera camera '{}': no configuration for the {} role", camera_id_, role_name));
   libcamera::StreamConfiguration& sc = camera_config_->at(0);
   const std::string offered = offers(sc.formats());
 
   std::optional<PixelFormat> wanted_format;
-  if (config.pixel_format != "auto") {
-    wanted_format = pixel_format_from_name(config.pixel_format);
+  if (config.pixel_format != CaptureFormat::Auto) {
+    wanted_format = frame_format(config.pixel_format);
     if (!wanted_format)
       throw CameraError(Kind::Refused, fmt::format("libcamera camera '{}': pixel format {} is not one arpipe takes "
                                                    "from libcamera (RGB24, YUYV, NV12, GREY); the camera offers {}",
-                                                   camera_id_, config.pixel_format, offered));
+                                                   camera_id_, choice_name(kCaptureFormatNames, config.pixel_format),
+                                                   offered));
     sc.pixelFormat = libcamera_pixel_format(*wanted_format);
   } else if (!pixel_format_from_libcamera(sc.pixelFormat)) {
     auto preferred = preferred_libcamera_format(sc.formats().pixelformats());

@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "core/config/source_choices.h"
+
 namespace arpipe {
 
 struct CameraMode {
@@ -21,7 +23,7 @@ struct CameraControl {
 };
 
 struct CameraDescription {
-  std::string backend;       // "v4l2" or "libcamera"
+  SourceType backend = SourceType::V4l2;  // the source.type that opens it: V4l2 or Libcamera
   std::string id;            // what source.device / source.camera takes
   std::string name;          // card or model name
   std::string location;      // bus info, or libcamera's Location property

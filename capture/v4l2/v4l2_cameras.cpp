@@ -55,7 +55,7 @@ std::vector<std::string> stable_links(const std::string& node) {
 
 CameraDescription describe(const std::string& path, bool capture_only, bool& keep) {
   CameraDescription d;
-  d.backend = "v4l2";
+  d.backend = SourceType::V4l2;
   d.id = path;
   keep = true;
   try {

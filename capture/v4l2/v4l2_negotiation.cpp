@@ -26,8 +26,10 @@ std::string format_name(uint32_t fourcc) {
   return fourcc_text(fourcc);
 }
 
-bool format_matches(uint32_t fourcc, const std::string& wanted) {
-  return wanted == "auto" ? is_usable_fourcc(fourcc) : format_name(fourcc) == wanted;
+bool format_matches(uint32_t fourcc, CaptureFormat wanted) {
+  if (wanted == CaptureFormat::Auto) return is_usable_fourcc(fourcc);
+  if (wanted == CaptureFormat::MJPG) return is_mjpeg_fourcc(fourcc);
+  return pixel_format_from_fourcc(fourcc) == frame_format(wanted);
 }
 
 bool size_matches(const V4L2FrameSize& size, const V4L2FormatRequest& request) {
@@ -83,7 +85,7 @@ V4L2FormatChoice choose_v4l2_format(const std::vector<V4L2FormatOffer>& offers, 
   for (int pass = 0; pass < 2; ++pass) {
     for (const auto& offer : offers) {
       if (!format_matches(offer.fourcc, request.pixel_format)) continue;
-      if (request.pixel_format == "auto" && is_mjpeg_fourcc(offer.fourcc) != (pass == 1)) continue;
+      if (request.pixel_format == CaptureFormat::Auto && is_mjpeg_fourcc(offer.fourcc) != (pass == 1)) continue;
       for (const auto& size : offer.sizes) {
         if (!size_matches(size, request)) continue;
         bool ok = false;
@@ -97,7 +99,7 @@ V4L2FormatChoice choose_v4l2_format(const std::vector<V4L2FormatOffer>& offers, 
         return {offer.fourcc, size.width, size.height, interval};
       }
     }
-    if (request.pixel_format != "auto") break;
+    if (request.pixel_format != CaptureFormat::Auto) break;
   }
   const std::string size = request.width || request.height
                                ? fmt::format("{}x{}", request.width ? fmt::format("{}", request.width) : "any",
@@ -105,7 +107,8 @@ V4L2FormatChoice choose_v4l2_format(const std::vector<V4L2FormatOffer>& offers, 
                                : "any size";
   const std::string rate = request.fps > 0 ? fmt::format("{:.4g} fps", request.fps) : "any rate";
   throw CameraError(CameraError::Kind::Refused,
-                    fmt::format("{}: cannot capture {} {} at {}; the camera offers:\n{}", device, request.pixel_format,
+                    fmt::format("{}: cannot capture {} {} at {}; the camera offers:\n{}", device,
+                                choice_name(kCaptureFormatNames, request.pixel_format),
                                 size, rate, describe_v4l2_offers(offers)));
 }
 

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "capture/v4l2/v4l2_device.h"
+#include "core/config/source_choices.h"
 
 namespace arpipe {
 
@@ -14,7 +15,7 @@ struct V4L2FormatRequest {
   int width = 0;                    // 0: the first size the camera lists
   int height = 0;
   double fps = 0;                   // 0: the first rate listed for that size
-  std::string pixel_format = "auto";  // "YUYV", "NV12", "RGB24", "GREY", "MJPG", or "auto"
+  CaptureFormat pixel_format = CaptureFormat::Auto;
 };
 
 struct V4L2FormatChoice {
@@ -32,7 +33,7 @@ bool same_rate(double fps, double wanted_fps);
 bool is_usable_fourcc(uint32_t fourcc);
 bool is_mjpeg_fourcc(uint32_t fourcc);  // 'MJPG' or 'JPEG'
 
-// The first offer that satisfies the request. "auto" prefers a format passed on as it is over
+// The first offer that satisfies the request. Auto prefers a format passed on as it is over
 // MJPEG (decoding costs), in the camera's order; rates match by same_rate(). Throws CameraError(Refused)
 // naming `device` and listing every usable offer when nothing fits.
 V4L2FormatChoice choose_v4l2_format(const std::vector<V4L2FormatOffer>& offers, const V4L2FormatRequest& request,

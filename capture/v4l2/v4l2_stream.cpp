@@ -38,9 +38,9 @@ namespace {
 int64_t timeval_ns(const timeval& tv) { return int64_t(tv.tv_sec) * 1'000'000'000 + int64_t(tv.tv_usec) * 1000; }
 
 // The driver's TSTAMP_SRC flag, unless the config overrides it (drivers disagree with their flags).
-TimestampMeaning timestamp_meaning(uint32_t flags, const std::string& configured) {
-  if (configured == "start-of-exposure") return TimestampMeaning::StartOfExposure;
-  if (configured == "end-of-frame") return TimestampMeaning::EndOfFrame;
+TimestampMeaning timestamp_meaning(uint32_t flags, BufferTimestamps configured) {
+  if (configured == BufferTimestamps::StartOfExposure) return TimestampMeaning::StartOfExposure;
+  if (configured == BufferTimestamps::EndOfFrame) return TimestampMeaning::EndOfFrame;
   return (flags & V4L2_BUF_FLAG_TSTAMP_SRC_MASK) == V4L2_BUF_FLAG_TSTAMP_SRC_SOE ? TimestampMeaning::StartOfExposure
                                                                                  : TimestampMeaning::EndOfFrame;
 }

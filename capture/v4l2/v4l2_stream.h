@@ -17,7 +17,7 @@ struct V4L2StreamSettings {
   V4L2FormatRequest request;
   uint32_t buffers = 4;
   V4L2ExposureSettings exposure;
-  std::string timestamp_meaning = "auto";   // auto (the buffer's flag), start-of-exposure, end-of-frame
+  BufferTimestamps timestamp_meaning = BufferTimestamps::DriverFlag;
   int64_t readout_ns = 0;
   int64_t timestamp_offset_ns = 0;
 };

@@ -10,13 +10,19 @@
 
 #include "core/config/config_rules.h"
 #include "core/config/blur_method.h"
+#include "core/config/egl_platform_request.h"
 #include "core/config/lens_mode.h"
 #include "core/config/log_level_names.h"
 #include "core/config/source_choices.h"
 #include "core/config/light_source.h"
+#include "core/config/object_prt.h"
+#include "core/config/probe_kind.h"
+#include "core/config/probe_method.h"
 #include "core/config/shadow_method.h"
 #include "core/geometry/vec.h"
+#include "core/environment/environment_layout.h"
 #include "core/image/camera_response.h"
+#include "core/sh/sh_window.h"
 
 namespace arpipe {
 
@@ -191,10 +197,9 @@ struct SceneObject {
   double yaw_rad = 0;                  // about world z
   double scale = 1.0;
   Vec3 color{0.8, 0.3, 0.1};           // linear base colour for builtin meshes
-  // Its environment light: "off" (SH irradiance at each pixel's normal, no self-shadowing), or the
-  // precomputed radiance transfer baked per vertex ([render.prt]): "unshadowed", "shadowed"
-  // (self-shadowing) or "interreflected" (plus one grey bounce).
-  std::string prt = "shadowed";
+  // Its environment light (core/config/object_prt.h): SH irradiance at each normal, or the
+  // precomputed radiance transfer baked per vertex ([render.prt]).
+  ObjectPrt prt = ObjectPrt::Shadowed;
   // Weight of a glossy reflection of the environment (the 3-band radiance along the mirror
   // direction, added untinted), [0, 1]; 0: purely diffuse.
   double specular = 0;
@@ -212,7 +217,7 @@ void visit(V& v, SceneObject& s) {
   v.key("yaw_deg", s.yaw_rad, Degrees{}, "about world z");
   v.key("scale", s.scale, NumberRange::above(0), "size factor");
   v.key("color", s.color, NumberRange::at_least(0), "linear base colour of builtin meshes");
-  v.key("prt", s.prt, OneOf{{"off", "unshadowed", "shadowed", "interreflected"}},
+  v.key("prt", s.prt, kObjectPrtNames,
         "environment light: off (SH irradiance at each normal) or the baked transfer ([render.prt])");
   v.key("specular", s.specular, NumberRange::closed(0, 1), "glossy reflection of the environment, added untinted");
 }
@@ -304,7 +309,7 @@ struct RenderConfig {
   Vec3 light_color{1.0, 1.0, 1.0};       // linear
   Vec3 ambient{0.25, 0.25, 0.25};        // linear
   int msaa_samples = 4;
-  std::string egl_platform = "auto";     // "auto", "surfaceless", "device"
+  EglPlatformRequest egl_platform = EglPlatformRequest::Auto;
   LensMode lens = LensMode::Map;
   // "map" only: canvas pixels per pinhole-core pixel, in [1, 4]. 4x multisampling alone leaves a
   // straight edge up to 1/8 canvas pixel off; a finer canvas divides that, at its square in fill
@@ -334,7 +339,8 @@ void visit(V& v, RenderConfig& s) {
   v.key("light_color", s.light_color, NumberRange::at_least(0), "linear RGB");
   v.key("ambient", s.ambient, NumberRange::at_least(0), "linear RGB");
   v.key("msaa_samples", s.msaa_samples, OneOfInts{{0, 1, 2, 4}, ""}, "multisampling");
-  v.key("egl_platform", s.egl_platform, OneOf{{"auto", "surfaceless", "device"}}, "EGL platform");
+  v.key("egl_platform", s.egl_platform, kEglPlatformRequestNames,
+        "EGL platform; auto: a device when the EGL device platform lists one, else surfaceless");
   v.key("lens", s.lens, kLensModeNames,
         "how the virtual layer matches the real lens: map: draw pinhole on an enlarged canvas, warp through a "
         "per-pixel map (any lens mrcal can unproject); vertex: distort per vertex (PINHOLE, OPENCV4/5/8); "
@@ -354,13 +360,11 @@ void visit(V& v, RenderConfig& s) {
 
 // A light probe sphere beside the anchor (core/light): where it is and what it is made of.
 struct ProbeConfig {
-  std::string kind = "mirror";           // "mirror" or "diffuse"
+  ProbeKind kind = ProbeKind::Mirror;
   Vec3 center_m{-0.15, 0.10, 0.04};      // world (anchor) frame
   double radius_m = 0.04;
   double reflectance = 0.9;              // mirror: specular reflectance; diffuse: albedo, (0, 1]
-  // "auto" (environment for a mirror, fit for a diffuse sphere), "environment", "fit",
-  // "seed-image" or "seed-sphere" (the seed's brightest-component method, image or sphere domain).
-  std::string method = "auto";
+  ProbeMethod method = ProbeMethod::Auto;  // core/config/probe_method.h
   int max_lights = 1;                    // dominant lights kept, 1..4
   // 0: the lights are infinitely far; > 0: the strongest is a lamp this far from the probe's
   // centre (measured by hand: a probe sees directions only).
@@ -373,12 +377,13 @@ struct ProbeConfig {
 // rule the value must meet, and the help `arpipe config --defaults` prints (docs/ARCHITECTURE.md, "Adding a config key").
 template <class V>
 void visit(V& v, ProbeConfig& s) {
-  v.key("kind", s.kind, OneOf{{"mirror", "diffuse"}}, "what the sphere is made of");
+  v.key("kind", s.kind, kProbeKindNames, "what the sphere is made of");
   v.key("center_m", s.center_m, "world frame");
   v.key("radius_m", s.radius_m, NumberRange::open_closed(0, 10).in("m"), "the sphere's radius");
   v.key("reflectance", s.reflectance, NumberRange::open_closed(0, 1), "mirror reflectance, or the diffuse sphere's albedo");
-  v.key("method", s.method, OneOf{{"auto", "environment", "fit", "seed-image", "seed-sphere"}},
-        "auto: environment for a mirror, fit for a diffuse sphere; seed-*: the brightest components");
+  v.key("method", s.method, kProbeMethodNames,
+        "auto: environment for a mirror, fit for a diffuse sphere; brightest-image, brightest-sphere (old names: "
+        "seed-image, seed-sphere): seeds 001/004's brightest components");
   v.key("max_lights", s.max_lights, IntRange{1, 4}, "dominant lights kept");
   v.key("light_distance_m", s.light_distance_m, NumberRange::closed(0, 1e6).in("m; 0: infinitely far"),
         "0: lights infinitely far; > 0: the key lamp's distance from the probe");
@@ -424,10 +429,10 @@ void visit(V& v, SunConfig& s) {
 // onto spherical harmonics once at configure.
 struct EnvironmentConfig {
   std::filesystem::path file;            // Radiance .hdr or OpenEXR .exr
-  std::string layout = "equirect";       // "angular", "mirror-ball", "equirect" or "cube-cross"
+  EnvironmentLayout layout = EnvironmentLayout::Equirectangular;
   double yaw_rad = 0;                    // turn of the probe about world z (probe up = world +z)
   double scale = 1;                      // radiance units of the file -> scene-linear units
-  std::string window = "none";           // "none", "hanning" or "lanczos": against ringing
+  ShWindow window = ShWindow::None;      // against ringing
 
   bool operator==(const EnvironmentConfig&) const = default;
 };
@@ -437,10 +442,10 @@ struct EnvironmentConfig {
 template <class V>
 void visit(V& v, EnvironmentConfig& s) {
   v.key("file", s.file, "Radiance .hdr or OpenEXR .exr; required with source = \"environment\"");
-  v.key("layout", s.layout, OneOf{{"angular", "mirror-ball", "equirect", "cube-cross"}}, "the file's projection");
+  v.key("layout", s.layout, kEnvironmentLayoutNames, "the file's projection");
   v.key("yaw_deg", s.yaw_rad, Degrees{}, "turn of the probe about world z (probe up = world z)");
   v.key("scale", s.scale, NumberRange::open_closed(0, 1e12), "the file's radiance units to scene-linear units");
-  v.key("window", s.window, OneOf{{"none", "hanning", "lanczos"}}, "SH windowing against ringing");
+  v.key("window", s.window, kShWindowNames, "SH windowing against ringing");
 }
 
 // The light stage: where the light comes from.

@@ -17,7 +17,7 @@ namespace {
 TEST(LibcameraCameras, ListingNamesEveryCameraByIdAndNeverFails) {
   const auto cameras = list_libcamera_cameras();
   for (const auto& c : cameras) {
-    EXPECT_EQ(c.backend, "libcamera");
+    EXPECT_EQ(c.backend, SourceType::Libcamera);
     EXPECT_TRUE(!c.id.empty() || !c.error.empty());
   }
   // A second listing reuses the one manager (libcamera allows one per process).
@@ -26,7 +26,7 @@ TEST(LibcameraCameras, ListingNamesEveryCameraByIdAndNeverFails) {
 
 CameraError open_error(const std::string& camera) {
   SourceConfig config;
-  config.type = "libcamera";
+  config.type = SourceType::Libcamera;
   config.camera = camera;
   try {
     open_libcamera_stream(config);

@@ -129,7 +129,7 @@ TEST_F(RecordingLimits, ANumberNoDoubleHoldsIsARecordingError) {
 
 TEST_F(RecordingLimits, ReplayNamesAnEmptySourcePath) {
   SourceConfig config;
-  config.pacing = "fast";
+  config.pacing = ReplayPacing::Fast;
   // Before: ": not a recording (no such directory)", naming nothing.
   EXPECT_EQ(error_message<ConfigError>([&] { ReplaySource source(config); }),
             "source.path is empty: a replay needs the recording directory (set source.path, or source.type for a "
@@ -156,7 +156,7 @@ TEST_F(RecordingLimits, ATimestampOffsetThatOverflowsIsRefusedAtStart) {
   write_file(dir_ / "frames.jsonl", out);
   SourceConfig config;
   config.path = dir_;
-  config.pacing = "fast";
+  config.pacing = ReplayPacing::Fast;
   ReplaySource{config};  // without an offset the recording replays
   config.timestamp_offset_ns = 3'600'000'000'000;
   const std::string message = error_message<ConfigError>([&] { ReplaySource source(config); });

@@ -21,7 +21,7 @@ std::vector<V4L2FormatOffer> webcam() {
 }
 
 TEST(V4L2Negotiation, AutoPrefersAFormatPassedOnAsItIs) {
-  const auto choice = choose_v4l2_format(webcam(), {640, 480, 30, "auto"}, "/dev/video0");
+  const auto choice = choose_v4l2_format(webcam(), {640, 480, 30, CaptureFormat::Auto}, "/dev/video0");
   EXPECT_EQ(choice.fourcc, V4L2_PIX_FMT_YUYV);
   ASSERT_TRUE(choice.interval);
   EXPECT_EQ(choice.interval->numerator, 1u);
@@ -29,14 +29,14 @@ TEST(V4L2Negotiation, AutoPrefersAFormatPassedOnAsItIs) {
 }
 
 TEST(V4L2Negotiation, AutoFallsBackToMjpegWhenOnlyItCanDoTheRate) {
-  const auto choice = choose_v4l2_format(webcam(), {1920, 1080, 30, "auto"}, "/dev/video0");
+  const auto choice = choose_v4l2_format(webcam(), {1920, 1080, 30, CaptureFormat::Auto}, "/dev/video0");
   EXPECT_EQ(choice.fourcc, V4L2_PIX_FMT_MJPEG);
   ASSERT_TRUE(choice.interval);
   EXPECT_EQ(choice.interval->numerator, 333333u);  // within 0.5 % of 30 fps: the driver's own fraction
 }
 
 TEST(V4L2Negotiation, ZeroMeansTheFirstSizeAndRateListed) {
-  const auto choice = choose_v4l2_format(webcam(), {0, 0, 0, "YUYV"}, "/dev/video0");
+  const auto choice = choose_v4l2_format(webcam(), {0, 0, 0, CaptureFormat::YUYV}, "/dev/video0");
   EXPECT_EQ(choice.width, 640u);
   EXPECT_EQ(choice.height, 480u);
   EXPECT_EQ(choice.interval->denominator, 30u);
@@ -44,7 +44,7 @@ TEST(V4L2Negotiation, ZeroMeansTheFirstSizeAndRateListed) {
 
 TEST(V4L2Negotiation, RefusalListsEveryOfferAndNamesTheDevice) {
   try {
-    choose_v4l2_format(webcam(), {1280, 720, 30, "auto"}, "/dev/video7");
+    choose_v4l2_format(webcam(), {1280, 720, 30, CaptureFormat::Auto}, "/dev/video7");
     FAIL() << "1280x720 is not offered";
   } catch (const CameraError& e) {
     EXPECT_EQ(e.kind(), CameraError::Kind::Refused);
@@ -58,11 +58,11 @@ TEST(V4L2Negotiation, RefusalListsEveryOfferAndNamesTheDevice) {
 TEST(V4L2Negotiation, StepwiseSizesAcceptAnySizeInRange) {
   V4L2FormatOffer grey{V4L2_PIX_FMT_GREY, false, {}, "stepwise 64x64 to 1280x960 step 16x16"};
   grey.sizes = {{1280, 960, {}, {}}, {64, 64, {}, {}}};
-  const auto choice = choose_v4l2_format({grey}, {800, 600, 20, "GREY"}, "/dev/video0");
+  const auto choice = choose_v4l2_format({grey}, {800, 600, 20, CaptureFormat::GREY}, "/dev/video0");
   EXPECT_EQ(choice.width, 800u);
   ASSERT_TRUE(choice.interval);
   EXPECT_NEAR(choice.interval->fps(), 20.0, 1e-9);
-  EXPECT_THROW(choose_v4l2_format({grey}, {2000, 600, 0, "GREY"}, "/dev/video0"), CameraError);
+  EXPECT_THROW(choose_v4l2_format({grey}, {2000, 600, 0, CaptureFormat::GREY}, "/dev/video0"), CameraError);
 }
 
 }  // namespace

@@ -24,7 +24,7 @@ int64_t to_microseconds(int64_t ns) { return ns / 1000 * 1000; }
 
 SourceConfig v4l2_config(const std::string& device = kStandinDevice) {
   SourceConfig c;
-  c.type = "v4l2";
+  c.type = SourceType::V4l2;
   c.device = device;
   c.frame_timeout_ms = 1000;
   c.reconnect_min_ms = 20;
@@ -49,7 +49,7 @@ TEST(V4L2Source, NegotiatesWhatTheConfigAsks) {
   config.width = 640;
   config.height = 480;
   config.fps = 30;
-  config.pixel_format = "YUYV";
+  config.pixel_format = CaptureFormat::YUYV;
   auto source = make_live_source(config);
   EXPECT_EQ(source->format().format, PixelFormat::YUYV);
   EXPECT_EQ(source->format().width, 640);
@@ -64,7 +64,8 @@ TEST(V4L2Source, RefusesWhatTheCameraCannotDoAndListsWhatItOffers) {
   const auto dir = test::v4l2_scratch("refuse");
   test::StandinDevice device(dir, default_capture(), "formats = [\"native\", \"MJPG\"]");
   for (const auto& [width, height, fps, format] :
-       {std::tuple{1280, 720, 0.0, "auto"}, std::tuple{640, 480, 60.0, "auto"}, std::tuple{640, 480, 0.0, "NV12"}}) {
+       {std::tuple{1280, 720, 0.0, CaptureFormat::Auto}, std::tuple{640, 480, 60.0, CaptureFormat::Auto},
+        std::tuple{640, 480, 0.0, CaptureFormat::NV12}}) {
     auto config = v4l2_config();
     config.width = width;
     config.height = height;
@@ -72,7 +73,8 @@ TEST(V4L2Source, RefusesWhatTheCameraCannotDoAndListsWhatItOffers) {
     config.pixel_format = format;
     try {
       make_live_source(config);
-      ADD_FAILURE() << "accepted " << width << "x" << height << " " << fps << " fps " << format;
+      ADD_FAILURE() << "accepted " << width << "x" << height << " " << fps << " fps "
+                    << choice_name(kCaptureFormatNames, format);
     } catch (const CameraError& e) {
       EXPECT_EQ(e.kind(), CameraError::Kind::Refused);
       const std::string what = e.what();

@@ -57,7 +57,27 @@ TEST(Config, DefaultsAreTheDocumentedOnes) {
 
 TEST(Config, EmptyTextGivesTheDefaults) {
   EXPECT_EQ(parse_config("", "empty.toml"), default_config_from("empty.toml"));
-  EXPECT_EQ(parse_config("# only a comment\n[track]\n[sinks.png]\n", "c.toml"), default_config_from("c.toml"));
+  // An empty [sinks] names no sink (a sink's own table would turn it on: SinksAreOffUntilNamed).
+  EXPECT_EQ(parse_config("# only a comment\n[track]\n[sinks]\n", "c.toml"), default_config_from("c.toml"));
+}
+
+// The defaults that do not surprise: no virtual object and no sink unless the config names them.
+TEST(Config, SinksAreOffUntilNamedAndObjectsAbsentMeanNone) {
+  const Config none = parse_config("", "none.toml");
+  EXPECT_TRUE(none.render.objects.empty());
+  EXPECT_FALSE(none.sinks.png.enabled);
+  EXPECT_FALSE(none.sinks.y4m.enabled);
+  EXPECT_FALSE(none.sinks.recording.enabled);
+  EXPECT_FALSE(none.sinks.results.enabled);
+  const Config named = parse_config("[sinks.png]\n[sinks.results]\npath = \"r.jsonl\"\n[sinks.y4m]\nenabled = false\n", "named.toml");
+  EXPECT_TRUE(named.sinks.png.enabled);
+  EXPECT_EQ(named.sinks.png.dir, "out/png");  // the table's keys keep their defaults
+  EXPECT_TRUE(named.sinks.results.enabled);
+  EXPECT_EQ(named.sinks.results.path, "r.jsonl");
+  EXPECT_FALSE(named.sinks.y4m.enabled);  // named, and switched off by its own key
+  EXPECT_FALSE(named.sinks.recording.enabled);
+  // A --set naming a sink's key names the sink.
+  EXPECT_TRUE(parse_config("", "set.toml", {"sinks.y4m.path=v.y4m"}).sinks.y4m.enabled);
 }
 
 TEST(Config, DefaultTomlReadsBackAsTheDefaultConfigAndListsEveryKey) {
@@ -70,10 +90,13 @@ TEST(Config, DefaultTomlReadsBackAsTheDefaultConfigAndListsEveryKey) {
         "min_decision_margin = ", "ambiguity_ratio = ", "max_predicted_frames = ", "[[track.bundle]]", "id = ", "size_m = ", "center_m = ",
         "yaw_deg = ", "[motion]", "latency_frames = ", "default_exposure_ms = ", "[render]", "light_direction = ", "light_color = ", "ambient = ", "msaa_samples = ",
         "egl_platform = ", "lens = ", "lens_canvas_scale = ", "rolling_shutter = ", "max_predicted_uncertainty_deg = ", "[render.blur]", "method = ", "samples = ",
-        "min_motion_px = ", "[[render.objects]]", "mesh = ", "position_m = ",
-        "scale = ", "color = ", "[sinks.png]", "dir = ", "every = ", "[sinks.y4m]", "[sinks.recording]",
-        "[sinks.results]", "[pipeline]", "queue_depth = ", "max_frames = ", "log_level = "})
+        "min_motion_px = ", "[pipeline]", "queue_depth = ", "max_frames = ", "log_level = "})
     EXPECT_NE(text.find(std::string("\n") + line), std::string::npos) << line;
+  // Absent by default (no objects, no sinks), so shown commented out with the values they take
+  // when the config has them: reading the text back still gives the defaults (above).
+  for (const char* line : {"[[render.objects]]", "mesh = ", "position_m = ", "scale = ", "color = ", "[sinks.png]",
+                           "dir = ", "every = ", "[sinks.y4m]", "[sinks.recording]", "[sinks.results]"})
+    EXPECT_NE(text.find(std::string("\n# ") + line), std::string::npos) << line;
 }
 
 TEST(Config, ReadsEveryKey) {
@@ -176,7 +199,7 @@ log_level = "debug"
   EXPECT_EQ(c.render.light_color, (Vec3{2.0, 1.5, 1.0}));
   EXPECT_EQ(c.render.ambient, (Vec3{0.1, 0.1, 0.2}));
   EXPECT_EQ(c.render.msaa_samples, 2);
-  EXPECT_EQ(c.render.egl_platform, "surfaceless");
+  EXPECT_EQ(c.render.egl_platform, EglPlatformRequest::Surfaceless);
   EXPECT_EQ(c.render.lens, LensMode::Undistort);
   EXPECT_EQ(c.render.lens_canvas_scale, 2.0);
   ASSERT_EQ(c.render.objects.size(), 2u);
@@ -497,12 +520,12 @@ TEST(Config, BlurValuesOutOfRangeAreRefusedNamingFileAndKey) {
 
 TEST(Config, EnvironmentAndPrtKeysHaveTheirDefaultsAndReadBack) {
   const Config d;
-  EXPECT_EQ(d.light.environment.layout, "equirect");
+  EXPECT_EQ(d.light.environment.layout, EnvironmentLayout::Equirectangular);
   EXPECT_EQ(d.light.environment.scale, 1.0);
-  EXPECT_EQ(d.light.environment.window, "none");
+  EXPECT_EQ(d.light.environment.window, ShWindow::None);
   EXPECT_EQ(d.render.prt.samples, 32);
   EXPECT_EQ(d.render.prt.bands, 3);
-  EXPECT_EQ(d.render.objects.at(0).prt, "shadowed");
+  EXPECT_EQ(SceneObject{}.prt, ObjectPrt::Shadowed);
   const Config c = parse_config(
       "[light]\nsource = \"environment\"\n[light.environment]\nfile = \"probe.exr\"\nlayout = \"angular\"\n"
       "yaw_deg = 90\nscale = 2.5\nwindow = \"hanning\"\n[render.prt]\nsamples = 40\nbands = 5\ncache_dir = \"c\"\n"
@@ -510,14 +533,44 @@ TEST(Config, EnvironmentAndPrtKeysHaveTheirDefaultsAndReadBack) {
       "e.toml");
   EXPECT_EQ(c.light.source, LightSource::Environment);
   EXPECT_EQ(c.light.environment.file, fs::path("probe.exr"));
-  EXPECT_EQ(c.light.environment.layout, "angular");
+  EXPECT_EQ(c.light.environment.layout, EnvironmentLayout::AngularMap);
   EXPECT_NEAR(c.light.environment.yaw_rad, kPi / 2, 1e-15);
   EXPECT_EQ(c.light.environment.scale, 2.5);
-  EXPECT_EQ(c.light.environment.window, "hanning");
+  EXPECT_EQ(c.light.environment.window, ShWindow::Hanning);
   EXPECT_EQ(c.render.prt.samples, 40);
   EXPECT_EQ(c.render.prt.bands, 5);
   EXPECT_EQ(c.render.prt.cache_dir, fs::path("c"));
-  EXPECT_EQ(c.render.objects.at(0).prt, "interreflected");
+  EXPECT_EQ(c.render.objects.at(0).prt, ObjectPrt::Interreflected);
+}
+
+TEST(Config, ProbeKeysReadThroughTheirNameTablesWithTheSeedsOldNames) {
+  const Config d;
+  EXPECT_EQ(d.light.probe.kind, ProbeKind::Mirror);
+  EXPECT_EQ(d.light.probe.method, ProbeMethod::Auto);
+  EXPECT_EQ(d.light.source, LightSource::Fixed);
+  const Config c = parse_config("[light]\nsource = \"probe\"\n[light.probe]\nkind = \"diffuse\"\nmethod = \"brightest-sphere\"\n", "p.toml");
+  EXPECT_EQ(c.light.source, LightSource::Probe);
+  EXPECT_EQ(c.light.probe.kind, ProbeKind::Diffuse);
+  EXPECT_EQ(c.light.probe.method, ProbeMethod::BrightestSphere);
+  // seeds 001/004's method under its old names; the new names are written.
+  EXPECT_EQ(parse_config("[light.probe]\nmethod = \"seed-image\"\n", "p.toml").light.probe.method, ProbeMethod::BrightestImage);
+  EXPECT_EQ(parse_config("", "p.toml", {"light.probe.method=seed-sphere"}).light.probe.method, ProbeMethod::BrightestSphere);
+  EXPECT_EQ(probe_method_name(ProbeMethod::BrightestImage), "brightest-image");
+  expect_error("[light.probe]\nmethod = \"median\"\n",
+               {"test.toml:2:", "light.probe.method: expected one of \"auto\", \"environment\", \"fit\", \"brightest-image\", "
+                                "\"brightest-sphere\"", "found \"median\""});
+  expect_error("[light.probe]\nkind = \"glass\"\n", {"light.probe.kind: expected one of \"mirror\", \"diffuse\""});
+  expect_error("[light.environment]\nwindow = \"hamming\"\n",
+               {"light.environment.window: expected one of \"none\", \"hanning\", \"lanczos\""});
+}
+
+// --defaults names each choice's old names next to its rule.
+TEST(Config, DefaultsListTheOldNamesOfRenamedChoices) {
+  const std::string text = default_config_toml();
+  EXPECT_NE(text.find("method = \"intraframe-warp\""), std::string::npos) << text;
+  EXPECT_NE(text.find("\"seed\" (= \"intraframe-warp\")"), std::string::npos) << text;
+  EXPECT_NE(text.find("\"seed-image\" (= \"brightest-image\"), \"seed-sphere\" (= \"brightest-sphere\")"), std::string::npos)
+      << text;
 }
 
 TEST(Config, EnvironmentAndPrtValuesOutOfRangeAreRefusedNamingFileAndKey) {

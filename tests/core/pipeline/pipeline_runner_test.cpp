@@ -127,16 +127,16 @@ class FakeSource : public FrameSource {
 };
 
 struct StageLog : SharedLog {
-  std::vector<std::string> configured;  // the pipeline.log_level of every configure() call, accepted or not
+  std::vector<std::string> configured;  // the source.camera of every configure() call, accepted or not
   std::vector<uint64_t> processed;      // sequence numbers
   std::vector<std::string> events;      // "look N" and "process N" in the order they happened
   bool inside_process = false;
 };
 
-// Configs are told apart by pipeline.log_level, which no fake looks at otherwise.
+// Configs are told apart by source.camera (a string), which no fake looks at otherwise.
 Config config_marked(const std::string& marker, int queue_depth = 4, int64_t max_frames = 0) {
   Config config;
-  config.pipeline.log_level = marker;
+  config.source.camera = marker;
   config.pipeline.queue_depth = queue_depth;
   config.pipeline.max_frames = max_frames;
   return config;
@@ -200,12 +200,12 @@ class FakeStage : public Stage {
     {
       std::lock_guard lock(log_->mutex);
       refuse = (behaviour_.refuse_first_configure && log_->configured.empty()) ||
-               (!behaviour_.refuse_marker.empty() && config.pipeline.log_level == behaviour_.refuse_marker);
-      log_->configured.push_back(config.pipeline.log_level);
+               (!behaviour_.refuse_marker.empty() && config.source.camera == behaviour_.refuse_marker);
+      log_->configured.push_back(config.source.camera);
       log_->changed.notify_all();
     }
     if (refuse)
-      throw ConfigError(fmt::format("{} refuses log_level '{}'", behaviour_.name, config.pipeline.log_level));
+      throw ConfigError(fmt::format("{} refuses source.camera '{}'", behaviour_.name, config.source.camera));
   }
 
   void process(FrameContext& ctx) noexcept override {
@@ -552,7 +552,7 @@ TEST(PipelineRunner, StageThatRefusesItsFirstConfigMakesStartThrowAndNothingRuns
     h.runner->start();
     ADD_FAILURE() << "start() did not throw";
   } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("picky refuses log_level 'run'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("picky refuses source.camera 'run'"), std::string::npos) << e.what();
   }
   EXPECT_EQ(h.source_log->next_calls, 0);
   EXPECT_TRUE(h.sink_logs[0]->sequences.empty());
@@ -585,7 +585,7 @@ TEST(PipelineRunner, ReconfigureRefusedByOneStagePutsEveryStageBackOnTheRunningC
   std::string error = "stale text";
   EXPECT_FALSE(h.runner->reconfigure(config_marked("refused", 2), error));
   EXPECT_NE(error.find("stage b"), std::string::npos) << error;
-  EXPECT_NE(error.find("b refuses log_level 'refused'"), std::string::npos) << error;
+  EXPECT_NE(error.find("b refuses source.camera 'refused'"), std::string::npos) << error;
   // a took the new config before b refused it, so it must have been given the old one again;
   // c never saw it, and ends on the old one too.
   EXPECT_EQ(h.configured(0), (std::vector<std::string>{"original", "refused", "original"}));

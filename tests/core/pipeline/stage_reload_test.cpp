@@ -26,10 +26,10 @@ namespace {
 
 using namespace std::chrono_literals;
 
-// Configs are told apart by pipeline.log_level, which nothing here looks at otherwise.
+// Configs are told apart by source.camera (a string), which nothing here looks at otherwise.
 Config marked(const std::string& marker) {
   Config config;
-  config.pipeline.log_level = marker;
+  config.source.camera = marker;
   config.pipeline.queue_depth = 2;
   return config;
 }
@@ -142,7 +142,7 @@ class LoadingStage : public Stage {
     if (!script_.loads) return {};
     // Holds no reference to the stage, as the contract asks.
     return [script = script_, log = log_](const Config& config) -> std::shared_ptr<const StageAssets> {
-      const std::string& marker = config.pipeline.log_level;
+      const std::string& marker = config.source.camera;
       log->record([&] {
         log->loaded.push_back(marker);
         log->loader_threads.push_back(std::this_thread::get_id());
@@ -159,10 +159,10 @@ class LoadingStage : public Stage {
     const auto* marked = dynamic_cast<const MarkedAssets*>(assets.get());
     log_->record([&] {
       log_->processing_thread = std::this_thread::get_id();
-      log_->configured.emplace_back(config.pipeline.log_level, marked ? marked->marker : "(none)");
+      log_->configured.emplace_back(config.source.camera, marked ? marked->marker : "(none)");
     });
-    if (config.pipeline.log_level == script_.refuses)
-      throw ConfigError(fmt::format("{} refuses '{}'", script_.name, config.pipeline.log_level));
+    if (config.source.camera == script_.refuses)
+      throw ConfigError(fmt::format("{} refuses '{}'", script_.name, config.source.camera));
   }
 
   void process(FrameContext&) noexcept override {
@@ -567,7 +567,7 @@ TEST(StageReload, OptionalStageComesAndGoesWithTheConfig) {
   picky.name = "picky";
   picky.loads = false;
   picky.refuses = "off-refused";
-  const auto on = [](const Config& c) { return c.pipeline.log_level.rfind("on", 0) == 0; };
+  const auto on = [](const Config& c) { return c.source.camera.rfind("on", 0) == 0; };
   Pipeline p({always, optional, picky}, marked("off"), {{"optional", on}});
   p.runner->start();
   const auto processed_by = [&](const std::string& stage) {
