@@ -97,11 +97,29 @@ class RowWriter {
   template <class Element>
   void sections(std::string_view name, std::vector<Element>& member, std::string_view help) {
     out_ += fmt::format("\n# {}\n", help);
-    for (Element& element : member) {
+    // An empty list by default: one element shown commented out, with its keys' defaults.
+    std::vector<Element> shown = member;
+    const bool example = shown.empty();
+    if (example) shown.emplace_back();
+    for (Element& element : shown) {
       RowWriter sub(out_, path(name));
-      out_ += fmt::format("[[{}]]\n", sub.dotted_);
+      if (example) sub.prefix_ = "# ";
+      out_ += fmt::format("{}[[{}]]\n", sub.prefix_, sub.dotted_);
       visit(sub, element);
     }
+  }
+  // A part that is on only when the config has its table (a sink): shown commented out, with the
+  // values it has when the table is there.
+  template <class Section>
+  void switched_section(std::string_view name, Section& member, std::string_view help) {
+    Section present = member;
+    present.enabled = true;
+    RowWriter sub(out_, path(name));
+    sub.prefix_ = "# ";
+    sub.header_ = fmt::format("[{}]", sub.dotted_);
+    sub.header_help_ = help;
+    sub.header_note_ = "; off unless the config has this table";
+    visit(sub, present);
   }
 
  private:
@@ -113,9 +131,9 @@ class RowWriter {
   void flush_header() {
     if (header_.empty()) return;
     if (header_help_.empty())
-      out_ += fmt::format("\n{}\n", header_);
+      out_ += fmt::format("\n{}{}\n", prefix_, header_);
     else
-      out_ += fmt::format("\n{:<31}# {}\n", header_ + " ", header_help_);
+      out_ += fmt::format("\n{:<31}# {}{}\n", prefix_ + header_ + " ", header_help_, header_note_);
     header_.clear();
   }
 
@@ -125,15 +143,17 @@ class RowWriter {
     std::string comment = rule;
     if (!help.empty()) comment += (comment.empty() ? "" : ": ") + std::string(help);
     if (comment.empty())
-      out_ += assignment + "\n";
+      out_ += prefix_ + assignment + "\n";
     else
-      out_ += fmt::format("{:<32}# {}\n", assignment + " ", comment);
+      out_ += fmt::format("{:<32}# {}\n", prefix_ + assignment + " ", comment);
   }
 
   std::string& out_;
   std::string dotted_;
   std::string header_;
   std::string_view header_help_;
+  std::string_view header_note_;
+  std::string prefix_;  // "# " for a table shown commented out (a list empty by default, a sink)
 };
 
 }  // namespace
@@ -141,6 +161,8 @@ class RowWriter {
 std::string default_config_toml() {
   std::string out =
       "# arpiped configuration: every key is optional and shows its default; unknown keys are errors.\n"
+      "# Tables shown commented out are absent by default: no virtual objects, and no sink writes\n"
+      "# until the config names it.\n"
       "# Units: metres, nanoseconds, and degrees for angles (the code works in radians).\n";
   Config defaults;
   RowWriter writer(out);

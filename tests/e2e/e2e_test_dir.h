@@ -36,6 +36,10 @@ class E2eTestDir : public ::testing::Test {
                         << "[sinks.y4m]\npath = \"" << (dir_ / "out.y4m").string() << "\"\n"
                         << "[sinks.results]\npath = \"" << (dir_ / "results.jsonl").string() << "\"\n"
                         << extra;
+    // The tests were written when a config without objects drew the default cube; they keep it
+    // (objects listed in `extra` replace it, so their indices stay as written).
+    if (extra.find("[[render.objects]]") == std::string::npos && extra.find("render.objects") == std::string::npos)
+      std::ofstream(path, std::ios::app) << "\n[[render.objects]]\nmesh = \"builtin:cube\"\n";
     return path;
   }
 

@@ -240,6 +240,7 @@ std::vector<SinkSlot> tagged_slots(std::shared_ptr<Log> log) {
 Config with_sinks(Config config, const std::string& png_dir, const std::string& results_path = "r") {
   config.sinks.png.enabled = !png_dir.empty();
   config.sinks.png.dir = png_dir;
+  config.sinks.results.enabled = true;  // named: a sink is off until the config names it
   config.sinks.results.path = results_path;
   return config;
 }
