@@ -102,8 +102,11 @@ TEST_F(ArpipeCli, SimulateThenReplay) {
   EXPECT_EQ(run({"simulate", "--scene", scene.string(), "--out", capture.string()}, nullptr, &err), 1);
   EXPECT_NE(err.find(capture.string()), std::string::npos) << err;
 
+  // The cube the defaults drew before a config had to name its objects: without an object in the
+  // scene there is nothing to track for.
   ASSERT_EQ(run({"replay", capture.string(), "--set", "sinks.png.enabled=false", "--set", "sinks.y4m.enabled=false",
-                 "--set", "sinks.results.path=\"" + (dir_ / "r.jsonl").string() + "\""},
+                 "--set", "sinks.results.path=\"" + (dir_ / "r.jsonl").string() + "\"", "--set",
+                 "render.objects=[{mesh=\"builtin:cube\"}]"},
                 nullptr, &err),
             0)
       << err;
