@@ -176,7 +176,7 @@ void add_sh_command(CLI::App& arpipe) {
       "world normal. --reconstruct writes the band-limited probe in the same layout and size: .hdr/.exr as\n"
       "linear radiance, .png tone-mapped with Reinhard's global operator (key 0.72) and sRGB-encoded.");
   auto options = std::make_shared<ShOptions>();
-  command->add_option("--probe", options->probe_file, "the HDR light probe (.hdr, .exr)")->type_name("FILE")->required();
+  command->add_option("--environment,--probe", options->probe_file, "the HDR environment file (.hdr, .exr); --probe is its old name")->type_name("FILE")->required();
   command->add_option("--layout", options->layout_name, "angular, mirror-ball, equirect or cube-cross")
       ->type_name("L")
       ->required()

@@ -277,7 +277,7 @@ TEST_F(ArpipeCli, ShPrintsTheCoefficientsAndIrradianceOfAProbeAndWritesItsRecons
   sky.rgb.assign(size_t(sky.width) * sky.height * 3, 0.5f);
   write_radiance_hdr(dir_ / "sky.hdr", sky);
   std::string out, err;
-  ASSERT_EQ(run({"sh", "--probe", (dir_ / "sky.hdr").string(), "--layout", "equirect", "--normal", "0.3,-0.2,1",
+  ASSERT_EQ(run({"sh", "--environment", (dir_ / "sky.hdr").string(), "--layout", "equirect", "--normal", "0.3,-0.2,1",
                  "--reconstruct", (dir_ / "back.hdr").string()},
                 &out, &err),
             0)
