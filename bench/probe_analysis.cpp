@@ -36,8 +36,13 @@ double angle_deg(const Vec3& a, const Vec3& b) {
 }
 
 struct Row {
-  std::string probe, method;
-  double light_distance_m = 0;
+  std::string probe;
+  ProbeMethod method = ProbeMethod::Auto;
+  double light_distance_m = 0;  // < 0: unknown, and a diffuse fit takes the light as far
+  // The method's name, and for a fit without a distance "(far light)".
+  std::string label() const {
+    return std::string(probe_method_name(method)) + (light_distance_m < 0 ? " (far light)" : "");
+  }
 };
 
 int run_probe_benchmark(const std::string& capture, int repeats) {
@@ -78,9 +83,10 @@ int run_probe_benchmark(const std::string& capture, int repeats) {
     const ProbeSphere mirror{ProbeSphere::Kind::Mirror, {-0.15, 0.10, 0.0395}, 0.04, 0.9};
     const ProbeSphere diffuse{ProbeSphere::Kind::Diffuse, {0.15, 0.16, 0.0395}, 0.04, 0.7};
     const std::vector<Row> rows = {
-        {"mirror", "environment", 0},  {"mirror", "environment", 0.5}, {"mirror", "seed-image", 0},
-        {"mirror", "seed-sphere", 0},  {"diffuse", "fit", 0},          {"diffuse", "fit (far light)", -1},
-        {"diffuse", "seed-image", 0},  {"diffuse", "seed-sphere", 0},
+        {"mirror", ProbeMethod::Environment, 0},      {"mirror", ProbeMethod::Environment, 0.5},
+        {"mirror", ProbeMethod::BrightestImage, 0},   {"mirror", ProbeMethod::BrightestSphere, 0},
+        {"diffuse", ProbeMethod::Fit, 0},             {"diffuse", ProbeMethod::Fit, -1},
+        {"diffuse", ProbeMethod::BrightestImage, 0},  {"diffuse", ProbeMethod::BrightestSphere, 0},
     };
     fmt::print("| probe | method | lamp distance given | ms per frame (median) | first frame ms (cold ray cache) | "
                "direction error median / max (deg) | key irradiance / truth (green) |\n");
@@ -88,7 +94,7 @@ int run_probe_benchmark(const std::string& capture, int repeats) {
     for (const Row& row : rows) {
       ProbeLightConfig config;
       config.sphere = row.probe == "mirror" ? mirror : diffuse;
-      config.method = row.method == "fit (far light)" ? "fit" : row.method;
+      config.method = row.method;
       config.light_distance_m = std::max(0.0, row.light_distance_m);
       config.fit_light_distance = row.light_distance_m >= 0;
       config.smoothing_s = 0;  // raw per-frame errors
@@ -115,7 +121,7 @@ int run_probe_benchmark(const std::string& capture, int repeats) {
         }
       }
       const std::string given = row.light_distance_m > 0 ? fmt::format("{} m", row.light_distance_m) : "no";
-      fmt::print("| {} | {} | {} | {:.3f} | {:.2f} | {:.2f} / {:.2f} | {} |\n", row.probe, row.method, given,
+      fmt::print("| {} | {} | {} | {:.3f} | {:.2f} | {:.2f} / {:.2f} | {} |\n", row.probe, row.label(), given,
                  median(times), first_ms, median(errors), errors.empty() ? NAN : *std::max_element(errors.begin(), errors.end()),
                  ratio.empty() || std::isnan(median(ratio)) ? std::string("-") : fmt::format("{:.3f}", median(ratio)));
     }

@@ -31,7 +31,7 @@ SE3 look_at(const Vec3& eye, const Vec3& target) {
 }
 
 // A 3 x 3 grid of the mesh filling most of the view, lit by the fixed light and an SH ambient.
-Config scene(const std::string& mesh, const std::string& prt, const std::filesystem::path& cache_dir) {
+Config scene(const std::string& mesh, ObjectPrt prt, const std::filesystem::path& cache_dir) {
   Config config;
   config.render.objects.clear();
   for (int j = -1; j <= 1; ++j)
@@ -50,7 +50,7 @@ Config scene(const std::string& mesh, const std::string& prt, const std::filesys
 }
 
 struct Variant {
-  std::string prt;
+  ObjectPrt prt;
   std::vector<std::unique_ptr<Stage>> stages;
   std::vector<double> render_ms;
 };
@@ -73,7 +73,7 @@ void print_prt_runtime_cost(int frames) {
              "Lambert |\n|---|---|---|---|---|\n",
              kWidth, kHeight, frames);
   for (const std::string mesh : {"builtin:sphere", "builtin:cup"}) {
-    Variant variants[2] = {{"off", make_gl_stages(), {}}, {"shadowed", make_gl_stages(), {}}};
+    Variant variants[2] = {{ObjectPrt::Off, make_gl_stages(), {}}, {ObjectPrt::Shadowed, make_gl_stages(), {}}};
     for (Variant& v : variants)
       for (auto& stage : v.stages) stage->configure(scene(mesh, v.prt, cache_dir));
     for (int frame = -3; frame < frames; ++frame)

@@ -13,11 +13,11 @@ RenderSession::~RenderSession() {
   layer_.reset();
 }
 
-void RenderSession::ensure_context(const std::string& egl_platform) {
+void RenderSession::ensure_context(EglPlatformRequest egl_platform) {
   if (context_) {
     if (egl_platform != platform_request_)
       log::warn("render: egl_platform changed from \"{}\" to \"{}\"; the change takes effect after a restart",
-                platform_request_, egl_platform);
+                egl_platform_request_name(platform_request_), egl_platform_request_name(egl_platform));
     return;
   }
   auto context = std::make_unique<EglContext>(egl_platform);

@@ -22,7 +22,7 @@ class RenderSession {
 
   // Creates the context and the virtual layer on the first call; throws RenderError when no
   // context can be made. The platform is fixed from then on: a later different request warns.
-  void ensure_context(const std::string& egl_platform);
+  void ensure_context(EglPlatformRequest egl_platform);
   bool has_context() const { return context_ != nullptr; }
   // Makes the context current on the calling thread; throws RenderError (also when there is none).
   void make_current() const;
@@ -36,7 +36,7 @@ class RenderSession {
 
  private:
   std::unique_ptr<EglContext> context_;
-  std::string platform_request_;
+  EglPlatformRequest platform_request_ = EglPlatformRequest::Auto;
   std::unique_ptr<VirtualLayer> layer_;  // declared after the context: destroyed before it
 };
 

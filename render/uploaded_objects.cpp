@@ -52,11 +52,12 @@ Bounds scaled(const Bounds& box, double scale) {
 // The first 3 bands of the object's baked transfer (from the cache, else baked now and cached),
 // or nothing for prt = "off".
 std::vector<float> transfer_for(const Config& config, size_t object_index, const std::string& mesh_source,
-                                const Mesh& mesh, const std::string& prt) {
-  const std::optional<TransferKind> kind = parse_transfer_kind(prt);
-  if (!kind || mesh.vertex_count() == 0) return {};
+                                const Mesh& mesh, ObjectPrt prt) {
+  if (prt == ObjectPrt::Off || mesh.vertex_count() == 0) return {};
   PrtBakeSettings settings;
-  settings.kind = *kind;
+  settings.kind = prt == ObjectPrt::Unshadowed ? TransferKind::Unshadowed
+                  : prt == ObjectPrt::Shadowed ? TransferKind::Shadowed
+                                               : TransferKind::Interreflected;
   settings.bands = config.render.prt.bands;
   settings.samples_per_axis = config.render.prt.samples;
   const std::filesystem::path cache_dir =
@@ -67,13 +68,13 @@ std::vector<float> transfer_for(const Config& config, size_t object_index, const
     load = load_or_bake_prt(mesh, settings, cache_dir);
   } catch (const std::exception& e) {
     throw AssetError(fmt::format("{}: render.objects[{}] (mesh \"{}\", prt = \"{}\"): {}", config_name(config),
-                                 object_index, mesh_source, prt, e.what()));
+                                 object_index, mesh_source, object_prt_name(prt), e.what()));
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   // Baking is expected once per mesh (info); a transfer that could not be cached is baked again at
   // every start (a warning).
   if (load.baked)
-    log::info("prt: baked {} transfer of {} ({} vertices, {} directions) in {:.2f} s{} ({})", prt, mesh_source,
+    log::info("prt: baked {} transfer of {} ({} vertices, {} directions) in {:.2f} s{} ({})", object_prt_name(prt), mesh_source,
               mesh.vertex_count(), settings.samples_per_axis * settings.samples_per_axis, seconds,
               load.file.empty() ? std::string() : fmt::format(" into {}", load.file.string()), load.note);
   if (load.note.find("not cached") != std::string::npos) log::warn("prt: {}: {}", mesh_source, load.note);
@@ -92,7 +93,7 @@ LoadedMeshes load_object_meshes(const Config& config) {
   std::map<std::string, size_t> index_of;  // mesh source and prt mode -> loaded.meshes
   for (size_t i = 0; i < config.render.objects.size(); ++i) {
     const SceneObject& object = config.render.objects[i];
-    const std::string key = object.mesh + "\n" + object.prt;
+    const std::string key = object.mesh + "\n" + std::string(object_prt_name(object.prt));
     auto found = index_of.find(key);
     if (found == index_of.end()) {
       LoadedMeshes::Entry entry;

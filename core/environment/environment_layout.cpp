@@ -225,24 +225,6 @@ std::optional<Vec3> cube_direction(int width, double px, double py) {
 
 }  // namespace
 
-std::optional<EnvironmentLayout> parse_environment_layout(std::string_view text) {
-  if (text == "angular") return EnvironmentLayout::AngularMap;
-  if (text == "mirror-ball") return EnvironmentLayout::MirrorBall;
-  if (text == "equirect") return EnvironmentLayout::Equirectangular;
-  if (text == "cube-cross") return EnvironmentLayout::CubeCross;
-  return std::nullopt;
-}
-
-std::string_view environment_layout_name(EnvironmentLayout layout) {
-  switch (layout) {
-    case EnvironmentLayout::AngularMap: return "angular";
-    case EnvironmentLayout::MirrorBall: return "mirror-ball";
-    case EnvironmentLayout::Equirectangular: return "equirect";
-    case EnvironmentLayout::CubeCross: return "cube-cross";
-  }
-  return "unknown";
-}
-
 std::optional<Vec3> environment_pixel_direction(EnvironmentLayout layout, int width, int height, double px, double py) {
   if (!(px >= -0.5 && px <= width - 0.5 && py >= -0.5 && py <= height - 0.5)) return std::nullopt;
   switch (layout) {

@@ -7,6 +7,7 @@
 #include <string>
 #include <string_view>
 
+#include "core/config/choice_names.h"
 #include "core/geometry/vec.h"
 
 namespace arpipe {
@@ -43,9 +44,19 @@ namespace arpipe {
 //   The other blank 2 x 2 face squares are outside the layout.
 enum class EnvironmentLayout { AngularMap, MirrorBall, Equirectangular, CubeCross };
 
-// "angular", "mirror-ball", "equirect", "cube-cross".
-std::optional<EnvironmentLayout> parse_environment_layout(std::string_view text);
-std::string_view environment_layout_name(EnvironmentLayout layout);
+inline constexpr ChoiceName<EnvironmentLayout> kEnvironmentLayoutNames[] = {
+    {"angular", EnvironmentLayout::AngularMap},
+    {"mirror-ball", EnvironmentLayout::MirrorBall},
+    {"equirect", EnvironmentLayout::Equirectangular},
+    {"cube-cross", EnvironmentLayout::CubeCross}};
+
+// The layout's name in kEnvironmentLayoutNames; parse returns nullopt for a name not in it.
+inline std::string_view environment_layout_name(EnvironmentLayout layout) {
+  return choice_name(kEnvironmentLayoutNames, layout);
+}
+inline std::optional<EnvironmentLayout> parse_environment_layout(std::string_view text) {
+  return choice_value(kEnvironmentLayoutNames, text);
+}
 
 // Unit direction in P seen at pixel position (px, py); nullopt outside the layout's valid region
 // (outside the image, outside the disk (r > 1), or in a blank square of the cross).

@@ -14,19 +14,15 @@ namespace arpipe {
 EnvironmentLighting load_environment_lighting(const Config& config, int bands) {
   const EnvironmentConfig& c = config.light.environment;
   const std::string where = config.file.empty() ? std::string("config") : config.file.string();
-  const std::optional<EnvironmentLayout> layout = parse_environment_layout(c.layout);
-  const std::optional<ShWindow> window = parse_sh_window(c.window);
-  if (!layout || !window)  // the config reader checked both names
-    throw ConfigError(fmt::format("{}: [light.environment]: unknown layout \"{}\" or window \"{}\"", where, c.layout, c.window));
   EnvironmentLighting out;
   try {
     const HdrEnvironment environment =
-        HdrEnvironment::load(c.file, *layout, default_world_from_probe(c.yaw_rad), c.scale);
+        HdrEnvironment::load(c.file, c.layout, default_world_from_probe(c.yaw_rad), c.scale);
     out.radiance_sh = project_environment(environment, bands);
   } catch (const std::exception& e) {
     throw ConfigError(fmt::format("{}: light.environment.file: {}", where, e.what()));
   }
-  apply_sh_window(out.radiance_sh, *window);
+  apply_sh_window(out.radiance_sh, c.window);
   out.estimate.state = LightState::Estimated;
   out.estimate.source = "environment";
   out.estimate.ambient_sh = to_sh9(out.radiance_sh);

@@ -48,11 +48,11 @@ void LightStage::configure_loaded(const Config& config, const std::shared_ptr<co
   LightEstimate environment;
   if (light.source == LightSource::Probe) {
     ProbeLightConfig c;
-    c.sphere.kind = light.probe.kind == "diffuse" ? ProbeSphere::Kind::Diffuse : ProbeSphere::Kind::Mirror;
+    c.sphere.kind = light.probe.kind;
     c.sphere.center_world = light.probe.center_m;
     c.sphere.radius_m = light.probe.radius_m;
     c.sphere.reflectance = light.probe.reflectance;
-    c.method = light.probe.method == "auto" ? "" : light.probe.method;
+    c.method = light.probe.method;
     c.max_lights = light.probe.max_lights;
     c.smoothing_s = light.smoothing_s;
     c.light_distance_m = light.probe.light_distance_m;
@@ -70,7 +70,7 @@ void LightStage::configure_loaded(const Config& config, const std::shared_ptr<co
     if (!loaded->environment) throw std::logic_error("LightStage::configure_loaded: the environment was not loaded");
     environment = *loaded->environment;
     log::info("light: environment {} ({}), ambient L00 = ({:.4g}, {:.4g}, {:.4g})", light.environment.file.string(),
-              light.environment.layout, environment.ambient_sh[0][0], environment.ambient_sh[0][1],
+              environment_layout_name(light.environment.layout), environment.ambient_sh[0][0], environment.ambient_sh[0][1],
               environment.ambient_sh[0][2]);
   }
   source_ = light.source;

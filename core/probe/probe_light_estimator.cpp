@@ -13,27 +13,10 @@
 
 namespace arpipe {
 
-std::string_view probe_method_name(ProbeMethod method) {
-  switch (method) {
-    case ProbeMethod::SeedImage: return "seed-image";
-    case ProbeMethod::SeedSphere: return "seed-sphere";
-    case ProbeMethod::Environment: return "environment";
-    case ProbeMethod::Fit: return "fit";
-  }
-  return "?";
-}
-
-ProbeMethod probe_method_from_name(std::string_view name, std::string_view where) {
-  for (ProbeMethod m : {ProbeMethod::SeedImage, ProbeMethod::SeedSphere, ProbeMethod::Environment, ProbeMethod::Fit})
-    if (name == probe_method_name(m)) return m;
-  throw std::invalid_argument(fmt::format(
-      "{}: probe method \"{}\": expected \"seed-image\", \"seed-sphere\", \"environment\" or \"fit\"", where, name));
-}
-
 void ProbeLightEstimator::configure(const ProbeLightConfig& config) {
   const bool mirror = config.sphere.kind == ProbeSphere::Kind::Mirror;
-  const ProbeMethod method = config.method.empty() ? (mirror ? ProbeMethod::Environment : ProbeMethod::Fit)
-                                                   : probe_method_from_name(config.method, "light.probe.method");
+  const ProbeMethod method = config.method == ProbeMethod::Auto ? (mirror ? ProbeMethod::Environment : ProbeMethod::Fit)
+                                                                : config.method;
   if (method == ProbeMethod::Environment && !mirror)
     throw std::invalid_argument("light.probe.method \"environment\" needs a mirror probe");
   if (method == ProbeMethod::Fit && mirror)
@@ -116,12 +99,12 @@ bool ProbeLightEstimator::measure(const Frame& frame, const CameraModel& model, 
   fresh.ambient_sh = {};
   std::vector<std::string> notes;
   switch (method_) {
-    case ProbeMethod::SeedImage:
-    case ProbeMethod::SeedSphere: {
+    case ProbeMethod::BrightestImage:
+    case ProbeMethod::BrightestSphere: {
       BrightestComponentsOptions o;
       o.max_lights = config_.max_lights;
       o.tolerance = config_.seed_tolerance;
-      const BrightestComponentsResult r = method_ == ProbeMethod::SeedImage
+      const BrightestComponentsResult r = method_ == ProbeMethod::BrightestImage
                                ? brightest_components_image(sphere, region_, patch_, model, T_cam_world, o)
                                : brightest_components_sphere(sphere, region_, patch_, model, T_cam_world, o);
       for (const BrightestComponent& c : r.components) {
@@ -131,7 +114,7 @@ bool ProbeLightEstimator::measure(const Frame& frame, const CameraModel& model, 
         diag_.light_clipped.push_back(c.clipped);
       }
       c_signal = r.components.empty() ? 0 : 1;
-      notes.push_back("seed method: light direction only, no irradiance or ambient");
+      notes.push_back("brightest-components method: light direction only, no irradiance or ambient");
       break;
     }
     case ProbeMethod::Environment: {
@@ -167,6 +150,7 @@ bool ProbeLightEstimator::measure(const Frame& frame, const CameraModel& model, 
       c_signal = std::clamp(1 - r.rms_residual / 0.2, 0.0, 1.0) * std::max(0.3, both_sides);
       break;
     }
+    case ProbeMethod::Auto: break;  // resolved by configure
   }
   for (size_t i = 0; i < diag_.light_clipped.size(); ++i)
     if (diag_.light_clipped[i] && method_ == ProbeMethod::Environment)

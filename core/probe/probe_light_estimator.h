@@ -7,6 +7,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/config/probe_method.h"
 #include "core/frame.h"
 #include "core/geometry/camera_model.h"
 #include "core/geometry/se3.h"
@@ -17,19 +18,9 @@
 
 namespace arpipe {
 
-enum class ProbeMethod {
-  SeedImage,    // seeds 001/004, image domain (direction only)
-  SeedSphere,   // seeds 001/004, sphere domain (direction only)
-  Environment,  // mirror: environment map, peaks and SH ambient (default for a mirror)
-  Fit,          // diffuse: light + first-order ambient fitted to the shading (default for diffuse)
-};
-std::string_view probe_method_name(ProbeMethod method);
-// "seed-image", "seed-sphere", "environment", "fit"; throws std::invalid_argument naming `where`.
-ProbeMethod probe_method_from_name(std::string_view name, std::string_view where);
-
 struct ProbeLightConfig {
   ProbeSphere sphere;
-  std::string method;             // empty: "environment" for a mirror, "fit" for a diffuse sphere
+  ProbeMethod method = ProbeMethod::Auto;  // Auto: Environment for a mirror, Fit for a diffuse sphere
   int max_lights = 1;
   double smoothing_s = 0.1;       // exponential time constant on directions, irradiance and SH; 0: none
   double min_confidence = 0.2;    // below: the frame is not used (Held)

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/config/probe_kind.h"
 #include "core/geometry/camera_model.h"
 #include "core/geometry/se3.h"
 #include "core/geometry/vec.h"
@@ -13,7 +14,7 @@
 namespace arpipe {
 
 struct ProbeSphere {
-  enum class Kind { Mirror, Diffuse };
+  using Kind = ProbeKind;  // core/config/probe_kind.h: the config key light.probe.kind
   Kind kind = Kind::Mirror;
   Vec3 center_world{0, 0, 0};
   double radius_m = 0.04;

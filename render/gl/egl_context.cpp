@@ -196,14 +196,11 @@ std::optional<std::string> create_on_display(EGLDisplay display, EGLDisplay& out
 
 }  // namespace
 
-EglContext::EglContext(std::string_view requested) : egl_(std::make_unique<Handles>()) {
-  if (requested != "auto" && requested != "surfaceless" && requested != "device")
-    throw RenderError(fmt::format("EGL platform \"{}\" is unknown (expected \"auto\", \"surfaceless\" or \"device\")",
-                                  requested));
+EglContext::EglContext(EglPlatformRequest requested) : egl_(std::make_unique<Handles>()) {
   const std::string extensions = client_extensions();
   std::vector<std::string> failures;
 
-  if (requested != "surfaceless") {
+  if (requested != EglPlatformRequest::Surfaceless) {
     if (std::optional<EglDevice> device = preferred_device()) {
       EGLDisplay display = get_platform_display(EGL_PLATFORM_DEVICE_EXT, device->handle);
       if (auto why = create_on_display(display, egl_->display, egl_->context)) {
@@ -218,7 +215,7 @@ EglContext::EglContext(std::string_view requested) : egl_(std::make_unique<Handl
                              : "device platform: EGL lacks EGL_EXT_platform_device / EGL_EXT_device_enumeration");
     }
   }
-  if (egl_->context == EGL_NO_CONTEXT && requested != "device") {
+  if (egl_->context == EGL_NO_CONTEXT && requested != EglPlatformRequest::Device) {
     if (has_word(extensions, "EGL_MESA_platform_surfaceless")) {
       EGLDisplay display = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY);
       if (auto why = create_on_display(display, egl_->display, egl_->context))
@@ -230,7 +227,8 @@ EglContext::EglContext(std::string_view requested) : egl_(std::make_unique<Handl
     }
   }
   if (egl_->context == EGL_NO_CONTEXT) {
-    std::string message = fmt::format("cannot create a headless OpenGL ES 3.0 context (egl_platform = \"{}\"):", requested);
+    std::string message = fmt::format("cannot create a headless OpenGL ES 3.0 context (egl_platform = \"{}\"):",
+                                      egl_platform_request_name(requested));
     for (const std::string& failure : failures) message += "\n  " + failure;
     throw RenderError(message);
   }

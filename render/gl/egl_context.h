@@ -6,6 +6,8 @@
 #include <string>
 #include <string_view>
 
+#include "core/config/egl_platform_request.h"
+
 namespace arpipe {
 
 enum class EglPlatform { Surfaceless, Device };
@@ -13,10 +15,10 @@ std::string_view egl_platform_name(EglPlatform platform);
 
 class EglContext {
  public:
-  // requested: "auto" (a device when the EGL device platform lists one, else surfaceless),
-  // "surfaceless" or "device". Makes the new context current on the calling thread.
+  // requested: Auto (a device when the EGL device platform lists one, else surfaceless),
+  // Surfaceless or Device. Makes the new context current on the calling thread.
   // Throws RenderError saying what was tried and why each attempt failed.
-  explicit EglContext(std::string_view requested);
+  explicit EglContext(EglPlatformRequest requested);
   ~EglContext();
   EglContext(const EglContext&) = delete;
   EglContext& operator=(const EglContext&) = delete;

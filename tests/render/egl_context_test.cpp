@@ -5,6 +5,7 @@
 #include <GLES3/gl3.h>
 #include <gtest/gtest.h>
 
+#include "core/config/config.h"
 #include "render/gl/render_errors.h"
 
 namespace arpipe {
@@ -38,7 +39,7 @@ void expect_working_gles3(const EglContext& context) {
 
 TEST(EglContext, SurfacelessPlatformComesUp) {
   if (!EglContext::platform_available(EglPlatform::Surfaceless)) GTEST_SKIP() << "no EGL_MESA_platform_surfaceless";
-  EglContext context("surfaceless");
+  EglContext context(EglPlatformRequest::Surfaceless);
   EXPECT_EQ(context.platform(), EglPlatform::Surfaceless);
   std::cout << "surfaceless: GL_RENDERER = " << context.gl_renderer() << ", GL_VERSION = " << context.gl_version() << "\n";
   expect_working_gles3(context);
@@ -46,7 +47,7 @@ TEST(EglContext, SurfacelessPlatformComesUp) {
 
 TEST(EglContext, DevicePlatformComesUp) {
   if (!EglContext::platform_available(EglPlatform::Device)) GTEST_SKIP() << "no EGL device";
-  EglContext context("device");
+  EglContext context(EglPlatformRequest::Device);
   EXPECT_EQ(context.platform(), EglPlatform::Device);
   EXPECT_FALSE(context.device_description().empty());
   std::cout << "device (" << context.device_description() << "): GL_RENDERER = " << context.gl_renderer() << "\n";
@@ -54,7 +55,7 @@ TEST(EglContext, DevicePlatformComesUp) {
 }
 
 TEST(EglContext, AutoPrefersADevice) {
-  EglContext context("auto");
+  EglContext context(EglPlatformRequest::Auto);
   const EglPlatform expected =
       EglContext::platform_available(EglPlatform::Device) ? EglPlatform::Device : EglPlatform::Surfaceless;
   EXPECT_EQ(context.platform(), expected);
@@ -63,18 +64,19 @@ TEST(EglContext, AutoPrefersADevice) {
 
 TEST(EglContext, TwoContextsOnOnePlatformLiveAndDieIndependently) {
   // Both share the EGL display; destroying one must not terminate the display under the other.
-  auto first = std::make_unique<EglContext>("auto");
-  EglContext second("auto");
+  auto first = std::make_unique<EglContext>(EglPlatformRequest::Auto);
+  EglContext second(EglPlatformRequest::Auto);
   first.reset();
   second.make_current();
   expect_working_gles3(second);
 }
 
+// The name is checked where the config is read (render.egl_platform); the context takes the enum.
 TEST(EglContext, UnknownPlatformNameIsRejected) {
   try {
-    EglContext context("wayland");
-    FAIL() << "expected RenderError";
-  } catch (const RenderError& e) {
+    parse_config("[render]\negl_platform = \"wayland\"\n", "egl.toml");
+    FAIL() << "expected ConfigError";
+  } catch (const ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("\"wayland\""), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("surfaceless"), std::string::npos) << e.what();
   }

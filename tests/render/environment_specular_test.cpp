@@ -29,7 +29,7 @@ TEST(EnvironmentSpecular, ReflectsTheSkyAlongTheMirrorDirection) {
   config.render.objects[0].mesh = "builtin:cube";
   config.render.objects[0].scale = 2.0;
   config.render.objects[0].color = {0, 0, 0};  // black: only the reflection shows
-  config.render.objects[0].prt = "off";
+  config.render.objects[0].prt = ObjectPrt::Off;
   config.render.objects[0].specular = specular;
   config.render.msaa_samples = 0;
   config.render.shadows.method = ShadowMethod::Off;

@@ -27,14 +27,14 @@ std::string error_of(const std::function<void()>& action) {
 }
 
 TEST(GlProgram, WorkingProgramLinksAndFindsItsUniform) {
-  EglContext context("auto");
+  EglContext context(EglPlatformRequest::Auto);
   GlProgram program("good", kVertex, kFragment);
   EXPECT_NE(program.id(), 0u);
   EXPECT_GE(program.uniform("u_color"), 0);
 }
 
 TEST(GlProgram, CompileErrorNamesTheProgramStageAndDriverLog) {
-  EglContext context("auto");
+  EglContext context(EglPlatformRequest::Auto);
   const std::string message = error_of([] {
     GlProgram("object shading", kVertex, "#version 300 es\nprecision mediump float;\nout vec4 c;\nvoid main() { c = undefined_thing; }\n");
   });
@@ -44,7 +44,7 @@ TEST(GlProgram, CompileErrorNamesTheProgramStageAndDriverLog) {
 }
 
 TEST(GlProgram, LinkErrorNamesTheProgram) {
-  EglContext context("auto");
+  EglContext context(EglPlatformRequest::Auto);
   // The fragment shader reads a varying that the vertex shader never writes.
   const std::string message = error_of([] {
     GlProgram("mismatched", kVertex,
@@ -54,7 +54,7 @@ TEST(GlProgram, LinkErrorNamesTheProgram) {
 }
 
 TEST(GlProgram, MissingUniformIsNamed) {
-  EglContext context("auto");
+  EglContext context(EglPlatformRequest::Auto);
   GlProgram program("good", kVertex, kFragment);
   const std::string message = error_of([&] { program.uniform("u_not_there"); });
   EXPECT_NE(message.find("good program has no uniform \"u_not_there\""), std::string::npos) << message;

@@ -32,7 +32,7 @@ constexpr double kHalfFloat = 1.0 / 1024;
 constexpr double kLeak = 1e-4;
 
 EglContext& context() {
-  static EglContext instance("auto");
+  static EglContext instance(EglPlatformRequest::Auto);
   return instance;
 }
 

@@ -88,7 +88,7 @@ std::vector<Vec3> points_across_the_image(const CameraModel& model) {
 }
 
 void expect_gpu_matches_camera_model(const CameraModel& model) {
-  EglContext context("auto");
+  EglContext context(EglPlatformRequest::Auto);
   const std::vector<Vec3> points = points_across_the_image(model);
   const std::vector<std::array<float, 4>> clip = clip_positions_on_gpu(model, points);
   double worst = 0;

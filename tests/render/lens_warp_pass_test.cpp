@@ -30,7 +30,7 @@ const std::shared_ptr<const LensWarpMap>& strong_map() {
 }
 
 EglContext& context() {
-  static EglContext instance("auto");
+  static EglContext instance(EglPlatformRequest::Auto);
   return instance;
 }
 

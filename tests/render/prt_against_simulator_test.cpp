@@ -86,7 +86,7 @@ std::shared_ptr<const CameraModel> camera() {
   return std::make_shared<const CameraModel>(CameraModel::pinhole(300.0, 300.0, 159.5, 119.5, kWidth, kHeight));
 }
 
-Config object_config(const std::string& mesh, const std::string& prt) {
+Config object_config(const std::string& mesh, ObjectPrt prt) {
   Config config;
   config.render.objects = {SceneObject{}};
   config.render.objects[0].mesh = mesh;
@@ -98,7 +98,7 @@ Config object_config(const std::string& mesh, const std::string& prt) {
   config.render.shadows.method = ShadowMethod::Off;
   config.light.source = LightSource::Environment;
   config.light.environment.file = sky_files().pipeline;
-  config.light.environment.layout = "equirect";
+  config.light.environment.layout = EnvironmentLayout::Equirectangular;
   return config;
 }
 
@@ -203,14 +203,14 @@ TEST(PrtAgainstSimulator, DiffuseSphereInAKnownEnvironmentMatchesRayTracing) {
   sphere.is_virtual = true;
   const Truth truth = ray_trace(sphere, pose);
   const std::vector<bool> all(truth.interior.size(), true);
-  for (const std::string prt : {"off", "shadowed"}) {
+  for (const ObjectPrt prt : {ObjectPrt::Off, ObjectPrt::Shadowed}) {
     const Errors errors = compare(render(object_config("builtin:sphere", prt), pose), truth, all);
-    ASSERT_GT(errors.pixels, 300) << prt;
+    ASSERT_GT(errors.pixels, 300) << object_prt_name(prt);
     // 3 %: 9 coefficients of a smooth sky give ~1 % irradiance error (bench sh), the 1024-sample
     // truth ~1 % noise per pixel, 8-bit output ~0.3 %, the 24-ring mesh's facets well under 1 %.
-    EXPECT_LT(errors.mean_relative, 0.03) << "prt = " << prt << " over " << errors.pixels << " pixels";
-    RecordProperty("sphere_error_" + prt, std::to_string(errors.mean_relative));
-    std::cout << "sphere, prt = " << prt << ": mean error " << errors.mean_relative << " over " << errors.pixels
+    EXPECT_LT(errors.mean_relative, 0.03) << "prt = " << object_prt_name(prt) << " over " << errors.pixels << " pixels";
+    RecordProperty("sphere_error_" + std::string(object_prt_name(prt)), std::to_string(errors.mean_relative));
+    std::cout << "sphere, prt = " << object_prt_name(prt) << ": mean error " << errors.mean_relative << " over " << errors.pixels
               << " pixels\n";
   }
 }
@@ -241,8 +241,8 @@ TEST(PrtAgainstSimulator, ShadowedTransferIsCloserThanUnshadowedInsideAConcaveMo
       in_pit.push_back(hit.hit() && p[2] < 0.06 - 1e-3 && std::abs(p[0]) < 0.02 && std::abs(p[1]) < 0.02);
       all.push_back(true);
     }
-  const std::vector<Vec3> unshadowed = render(object_config("builtin:cup", "unshadowed"), pose);
-  const std::vector<Vec3> shadowed = render(object_config("builtin:cup", "shadowed"), pose);
+  const std::vector<Vec3> unshadowed = render(object_config("builtin:cup", ObjectPrt::Unshadowed), pose);
+  const std::vector<Vec3> shadowed = render(object_config("builtin:cup", ObjectPrt::Shadowed), pose);
   write_sampled("cup-ray-traced", truth.radiance);
   write_sampled("cup-prt-unshadowed", unshadowed);
   write_sampled("cup-prt-shadowed", shadowed);

@@ -27,7 +27,7 @@ constexpr int kSamples = 16;
 constexpr double kHalfFloat = 1.0 / 2048;  // relative rounding of the RGBA16F output
 
 EglContext& context() {
-  static EglContext instance("auto");
+  static EglContext instance(EglPlatformRequest::Auto);
   return instance;
 }
 
