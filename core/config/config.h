@@ -239,8 +239,8 @@ struct BlurConfig {
 template <class V>
 void visit(V& v, BlurConfig& s) {
   v.key("method", s.method, kBlurMethodNames,
-        "accumulate: N renders (the reference); intraframe-warp (old name: seed): seed 000's 2 renders + affine "
-        "warps; velocity: fastest");
+        "accumulate: N renders (the reference); intraframe-warp: seed 000's 2 renders + affine warps; "
+        "velocity: fastest");
   // 1024: far beyond what converges (bench blur's reference uses 256); intraframe-warp caps at 50.
   v.key("samples", s.samples, IntRange{0, 1024}, "0: from the frame's image motion");
   v.key("min_motion_px", s.min_motion_px, NumberRange::closed(0, 1000).in("pixels"),
@@ -382,8 +382,8 @@ void visit(V& v, ProbeConfig& s) {
   v.key("radius_m", s.radius_m, NumberRange::open_closed(0, 10).in("m"), "the sphere's radius");
   v.key("reflectance", s.reflectance, NumberRange::open_closed(0, 1), "mirror reflectance, or the diffuse sphere's albedo");
   v.key("method", s.method, kProbeMethodNames,
-        "auto: environment for a mirror, fit for a diffuse sphere; brightest-image, brightest-sphere (old names: "
-        "seed-image, seed-sphere): seeds 001/004's brightest components");
+        "auto: environment for a mirror, fit for a diffuse sphere; brightest-image, brightest-sphere: "
+        "seeds 001/004's brightest components");
   v.key("max_lights", s.max_lights, IntRange{1, 4}, "dominant lights kept");
   v.key("light_distance_m", s.light_distance_m, NumberRange::closed(0, 1e6).in("m; 0: infinitely far"),
         "0: lights infinitely far; > 0: the key lamp's distance from the probe");
