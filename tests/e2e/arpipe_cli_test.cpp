@@ -150,7 +150,7 @@ TEST_F(ArpipeCli, BenchBlurPrintsItsTableOnAShortCapture) {
             0)
       << err;
   ASSERT_EQ(run({"bench", "blur", "--capture", capture.string(), "--reference-samples", "16"}, &out, &err), 0) << err;
-  for (const char* row : {"| accumulate 16 (reference) |", "| off auto |", "| seed auto |", "| velocity auto |"})
+  for (const char* row : {"| accumulate 16 (reference) |", "| off auto |", "| intraframe-warp auto |", "| velocity auto |"})
     EXPECT_NE(out.find(row), std::string::npos) << row << "\n" << out;
   EXPECT_EQ(run({"bench", "blur", "--capture", (dir_ / "missing").string()}, nullptr, &err), 1);
   EXPECT_NE(err.find("missing"), std::string::npos) << err;

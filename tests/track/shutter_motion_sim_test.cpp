@@ -24,6 +24,7 @@
 #include "capture/sim/simulator.h"
 #include "core/motion/motion_stage.h"
 #include "core/track/tag_tracker.h"
+#include "tests/track/tracking_config.h"
 #include "tests/track/simulated_capture.h"
 
 namespace arpipe {
@@ -120,7 +121,7 @@ TagPanRun run_tag_pan(const fs::path& dir) {
   const RecordingReader reader(dir);
   const auto camera = std::make_shared<CameraModel>(reader.camera_model());
   const auto& truth = reader.ground_truth();
-  Config config;  // the default bundle: tag 0 of tag36h11, 10 cm, at the origin, as simulated
+  Config config = test::tracking_config();  // the default bundle: tag 0 of tag36h11, 10 cm, at the origin, as simulated
   TagTracker tracker;
   tracker.configure(config);
   std::vector<FrameContext> frames(reader.frame_count());
@@ -217,7 +218,7 @@ PoseTimeOffsets pose_time_offsets(const fs::path& dir) {
   const auto truth_at = [&](int64_t t_ns) {
     return trajectory.T_cam_world(double(t_ns - scene.camera.first_exposure_start_ns) * 1e-9);
   };
-  Config config;
+  Config config = test::tracking_config();
   TagTracker tracker;
   tracker.configure(config);
   PoseTimeOffsets offsets;

@@ -16,6 +16,7 @@
 #include "capture/recording/recording_reader.h"
 #include "core/geometry/se3_interpolation.h"
 #include "core/track/tag_tracker.h"
+#include "tests/track/tracking_config.h"
 #include "tests/track/simulated_capture.h"
 
 namespace arpipe {
@@ -36,7 +37,7 @@ struct DropoutRun {
 
 // Frames 0..measured-1 as recorded, then `blanked` frames with no tag (the next frames' times).
 DropoutRun run_with_dropout(const RecordingReader& reader, int max_predicted, int measured, int blanked) {
-  Config config;
+  Config config = test::tracking_config();
   config.track.max_predicted_frames = max_predicted;
   TagTracker tracker;
   tracker.configure(config);
@@ -113,7 +114,7 @@ TEST(TagTrackerPrediction, ZeroDisablesPredictionAndOneMeasurementIsNotEnough) {
 }
 
 TEST(TagTrackerPrediction, OutOfRangeBoundIsAConfigErrorNamingTheKey) {
-  Config config;
+  Config config = test::tracking_config();
   config.file = "a.toml";
   config.track.max_predicted_frames = 31;
   TagTracker tracker;
@@ -137,7 +138,7 @@ struct TagPanCounts {
 };
 
 TagPanCounts run_tag_pan(const RecordingReader& reader, int max_predicted) {
-  Config config;
+  Config config = test::tracking_config();
   config.track.max_predicted_frames = max_predicted;
   TagTracker tracker;
   tracker.configure(config);

@@ -1,6 +1,7 @@
 // Tests of the TagTracker stage: configuration errors, the per-frame states (disabled, no model,
 // lost, tracking), and pose on simulated captures against their exact ground truth.
 #include "core/track/tag_tracker.h"
+#include "tests/track/tracking_config.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -21,7 +22,7 @@ namespace fs = std::filesystem;
 constexpr double kDeg = 3.14159265358979323846 / 180;
 
 Config config_named(const std::string& file) {
-  Config config;
+  Config config = test::tracking_config();
   config.file = file;
   return config;
 }
@@ -86,7 +87,7 @@ FrameContext blank_frame_context(int width, int height) {
 
 TEST(TagTrackerStates, NoTagIsLostWithATimingAndNoSkipReason) {
   TagTracker tracker;
-  tracker.configure(Config{});
+  tracker.configure(test::tracking_config());
   FrameContext ctx = blank_frame_context(320, 240);
   tracker.process(ctx);
   EXPECT_EQ(ctx.pose.state, TrackState::Lost);
@@ -97,7 +98,7 @@ TEST(TagTrackerStates, NoTagIsLostWithATimingAndNoSkipReason) {
 }
 
 TEST(TagTrackerStates, DisabledSkipsWithReasonDisabled) {
-  Config config;
+  Config config = test::tracking_config();
   config.track.enabled = false;
   TagTracker tracker;
   tracker.configure(config);
@@ -111,7 +112,7 @@ TEST(TagTrackerStates, DisabledSkipsWithReasonDisabled) {
 // "Skip what a scene doesn't need": with no virtual object (or rendering off) nothing uses the pose.
 TEST(TagTrackerStates, NothingVirtualSkipsTracking) {
   for (bool render_enabled : {true, false}) {
-    Config config;
+    Config config = test::tracking_config();
     config.render.enabled = render_enabled;
     if (render_enabled) config.render.objects.clear();
     TagTracker tracker;
@@ -126,7 +127,7 @@ TEST(TagTrackerStates, NothingVirtualSkipsTracking) {
 
 TEST(TagTrackerStates, MissingOrMismatchedCameraModelSkipsWithoutThrowing) {
   TagTracker tracker;
-  tracker.configure(Config{});
+  tracker.configure(test::tracking_config());
   FrameContext no_model = blank_frame_context(320, 240);
   no_model.camera_model.reset();
   tracker.process(no_model);
@@ -219,7 +220,7 @@ TEST(SimulatedCapture, PoseMatchesGroundTruthAndTheAnchorLandsWithinOnePixel) {
   const auto& truth = reader.ground_truth();
   ASSERT_EQ(truth.size(), reader.frame_count());
 
-  Config config;  // the default bundle: tag 0 of tag36h11, 10 cm, at the origin, as simulated
+  Config config = test::tracking_config();  // the default bundle: tag 0 of tag36h11, 10 cm, at the origin, as simulated
   TagTracker tracker;
   tracker.configure(config);
   int tracked = 0, sharp = 0, lost = 0;
@@ -289,7 +290,7 @@ TEST(SimulatedCapture, GreyWithAnyStrideAndNv12TrackLikeTheTruth) {
     const auto camera = std::make_shared<CameraModel>(reader.camera_model());
     const SE3& T_true = reader.ground_truth().at(0).T_cam_world_mid;
     TagTracker tracker;
-    tracker.configure(Config{});
+    tracker.configure(test::tracking_config());
     FrameContext ctx;
     reader.read(0, ctx.camera);
     ctx.camera_model = camera;
@@ -312,7 +313,7 @@ TEST(SimulatedCapture, GreyWithAnyStrideAndNv12TrackLikeTheTruth) {
     }
     padded.camera_model = camera;
     TagTracker fresh;
-    fresh.configure(Config{});
+    fresh.configure(test::tracking_config());
     fresh.process(padded);
     ASSERT_EQ(padded.pose.state, TrackState::Tracking);
     // Same pixels, same detector: the same pose to rounding.
@@ -324,7 +325,7 @@ TEST(SimulatedCapture, TagsOutsideTheBundleAreListedButNotUsed) {
   const ScratchCapture capture("other-id", PixelFormat::YUYV, 320, 240);
   const RecordingReader reader(capture.dir());
   const auto camera = std::make_shared<CameraModel>(reader.camera_model());
-  Config config;
+  Config config = test::tracking_config();
   config.track.bundle = {BundleTag{5, 0.1, {0, 0, 0}, 0}};
   TagTracker tracker;
   tracker.configure(config);
@@ -342,7 +343,7 @@ TEST(SimulatedCapture, ARefusedReconfigureKeepsTheRunningConfig) {
   const RecordingReader reader(capture.dir());
   const auto camera = std::make_shared<CameraModel>(reader.camera_model());
   TagTracker tracker;
-  tracker.configure(Config{});
+  tracker.configure(test::tracking_config());
   Config bad;
   bad.track.family = "no-such-family";
   EXPECT_THROW(tracker.configure(bad), ConfigError);
