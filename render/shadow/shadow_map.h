@@ -14,7 +14,7 @@
 #include "render/gl/gl_program.h"
 #include "render/uploaded_objects.h"
 #include "render/shadow/shadow_frustum.h"
-#include "render/shadow/shadow_method.h"
+#include "core/config/shadow_method.h"
 
 namespace arpipe {
 
