@@ -33,7 +33,8 @@ Config bench_config(const std::string& capture, int64_t frames, bool with_object
       fmt::format("source.path=\"{}\"", capture), "source.pacing=\"fast\"", "source.loop=true",
       fmt::format("pipeline.max_frames={}", frames), "sinks.png.enabled=false", "sinks.y4m.enabled=false",
       "sinks.results.enabled=false", "pipeline.log_level=\"warning\""};
-  if (!with_object) overrides.push_back("render.objects=[]");
+  // The default scene's cube, as configs/arpipe.toml names it (a config without objects draws none).
+  if (with_object) overrides.push_back("render.objects=[{mesh=\"builtin:cube\"}]");
   overrides.push_back(fmt::format("render.lens=\"{}\"", lens));
   return parse_config("", "(benchmark)", overrides);
 }
