@@ -37,6 +37,7 @@ Errors measure(const RecordingReader& reader, const std::vector<Frame>& frames, 
   Config config;
   config.track.quad_decimate = decimate;
   config.track.refine_corners = refine;
+  config.render.objects = {SceneObject{}};  // the tracker skips frames with nothing virtual in the scene
   TagTracker tracker;
   tracker.configure(config);
   auto model = std::make_shared<const CameraModel>(reader.camera_model());
