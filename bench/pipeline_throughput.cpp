@@ -1,20 +1,22 @@
-// Benchmark: per-stage time and frames per second of the embedded default scene and of
-// pass-through (no virtual object), and resident memory over a looped replay (soak).
-// `arpipe bench pipeline [--capture DIR] [--frames N] [--soak-seconds S]` prints a markdown table
-// for docs/BENCHMARKS.md. Timings depend on the machine; compare the
-// rows of one run with each other, not with another machine's.
+// Benchmark: per-stage time and frames per second of any config, of the same config with the
+// render's costly features off, and of pass-through (the same capture with no virtual object), in
+// one run; resident memory over a looped replay (soak).
+// `arpipe bench pipeline [--config FILE] [--capture DIR] [--frames N] [--set KEY=VALUE]...
+// [--soak-seconds S]` prints a markdown table for docs/BENCHMARKS.md. Timings depend on the
+// machine; compare the rows of one run with each other, not with another machine's.
 #include <fmt/format.h>
 #include <sys/utsname.h>
 
 #include <chrono>
-#include <cstdlib>
+#include <ctime>
 #include <fstream>
 #include <memory>
 #include <string>
 #include <thread>
+#include <vector>
 
-#include "apps/common/pipeline_assembly.h"
 #include "apps/cli/command_line.h"
+#include "apps/common/pipeline_assembly.h"
 #include "bench/benchmarks.h"
 #include "core/log.h"
 
@@ -28,74 +30,113 @@ long resident_kib() {
   return -1;
 }
 
-Config bench_config(const std::string& capture, int64_t frames, bool with_object, const std::string& lens = "map") {
-  std::vector<std::string> overrides{
-      fmt::format("source.path=\"{}\"", capture), "source.pacing=\"fast\"", "source.loop=true",
-      fmt::format("pipeline.max_frames={}", frames), "sinks.png.enabled=false", "sinks.y4m.enabled=false",
-      "sinks.results.enabled=false", "pipeline.log_level=\"warning\""};
-  // The default scene's cube, as configs/arpipe.toml names it (a config without objects draws none).
-  if (with_object) overrides.push_back("render.objects=[{mesh=\"builtin:cube\"}]");
-  overrides.push_back(fmt::format("render.lens=\"{}\"", lens));
-  return parse_config("", "(benchmark)", overrides);
+struct PipelineOptions {
+  std::string config = "configs/arpipe.toml";
+  std::string capture;  // empty: the config's source
+  int64_t frames = 300;
+  std::vector<std::string> overrides;
+  int soak_seconds = 0;
+};
+
+// The config as the user runs it, with the sinks off (this measures the pipeline, not the disk), a
+// fast looped replay of `frames` frames, and `extra` overrides on top of the user's.
+Config bench_config(const PipelineOptions& options, int64_t frames, const std::vector<std::string>& extra = {}) {
+  std::vector<std::string> overrides = options.overrides;
+  if (!options.capture.empty()) overrides.push_back(fmt::format("source.path=\"{}\"", options.capture));
+  for (const char* o : {"source.pacing=\"fast\"", "source.loop=true", "sinks.png.enabled=false",
+                               "sinks.y4m.enabled=false", "sinks.recording.enabled=false", "sinks.results.enabled=false",
+                               "pipeline.log_level=\"warning\""})
+    overrides.push_back(o);
+  overrides.push_back(fmt::format("pipeline.max_frames={}", frames));
+  overrides.insert(overrides.end(), extra.begin(), extra.end());
+  return load_config(options.config, overrides);
 }
 
 PipelineMetrics run(const Config& config) {
-  // Sinks are off: this measures the pipeline, not the disk.
   PipelineRunner runner(make_source(config), make_stage_factory(), {}, config);
   runner.start();
   runner.wait();
   return runner.metrics();
 }
 
-void print_row(const std::string& name, const PipelineMetrics& m) {
-  auto stage_ms = [&](const std::string& stage) {
-    auto it = m.stages.find(stage);
-    if (it == m.stages.end() || it->second.runs == 0) return std::string("-");
-    uint64_t skipped = 0;
-    for (const auto& [reason, count] : it->second.skips) skipped += count;
-    return fmt::format("{:.2f}{}", it->second.total_ms / double(it->second.runs),
-                       skipped ? fmt::format(" ({} skipped)", skipped) : "");
-  };
-  fmt::print("| {} | {} | {:.1f} | {} | {} | {} |\n", name, m.frames_out, m.fps(), stage_ms("track"),
-             stage_ms("render"), stage_ms("composite"));
+double mean_ms(const PipelineMetrics& m, const std::string& stage) {
+  const auto it = m.stages.find(stage);
+  return it == m.stages.end() || it->second.runs == 0 ? 0 : it->second.total_ms / double(it->second.runs);
 }
 
-struct PipelineOptions {
-  std::string capture = "build/default-capture";
-  int64_t frames = 600;
-  int soak_seconds = 0;
-};
+// "2.31", with the skips that went into the mean ("2.31 (12 skipped)"); "-" when it never ran.
+std::string stage_cell(const PipelineMetrics& m, const std::string& stage) {
+  const auto it = m.stages.find(stage);
+  if (it == m.stages.end() || it->second.runs == 0) return "-";
+  uint64_t skipped = 0;
+  for (const auto& [reason, count] : it->second.skips) skipped += count;
+  return fmt::format("{:.2f}{}", mean_ms(m, stage), skipped ? fmt::format(" ({} skipped)", skipped) : "");
+}
+
+// The stages in pipeline order; "shadow" is part of "render" (its shadow map).
+const std::vector<std::string> kStages{"track", "motion", "light", "render", "shadow", "composite"};
+
+void print_row(const std::string& name, const PipelineMetrics& m) {
+  std::string cells;
+  for (const std::string& stage : kStages) cells += " " + stage_cell(m, stage) + " |";
+  fmt::print("| {} | {} | {:.1f} |{}\n", name, m.frames_out, m.fps(), cells);
+}
+
+std::string utc_now() {
+  const std::time_t now = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&now, &tm);
+  char text[32];
+  std::strftime(text, sizeof text, "%Y-%m-%d %H:%M UTC", &tm);
+  return text;
+}
 
 int run_pipeline_benchmark(const PipelineOptions& options) {
-  const std::string& capture = options.capture;
-  const int64_t frames = options.frames;
-  const int soak_seconds = options.soak_seconds;
   log::set_max_level(log::Level::Warning);
   utsname u{};
   uname(&u);
-  fmt::print("machine: {} {}, {} hardware threads\n\n", u.sysname, u.machine, std::thread::hardware_concurrency());
-  fmt::print("| run | frames | frames/s | track ms | render ms | composite ms |\n|---|---:|---:|---:|---:|---:|\n");
-  // Warm-up (shader JIT, page cache), then the measured runs.
-  run(bench_config(capture, 30, true));
-  print_row("default scene (cube on tag), render.lens = map (default)", run(bench_config(capture, frames, true)));
-  print_row("default scene, render.lens = vertex", run(bench_config(capture, frames, true, "vertex")));
-  print_row("default scene, render.lens = undistort", run(bench_config(capture, frames, true, "undistort")));
-  print_row("pass-through (no virtual object)", run(bench_config(capture, frames, false)));
+  // Parsed once up front, so that a bad config or --set fails before any measuring.
+  const Config config = bench_config(options, options.frames);
+  fmt::print("config {}{}, capture {}, {} frames per run; {} {}, {} hardware threads; {}\n\n", options.config,
+             options.overrides.empty() ? "" : " with --set " + fmt::format("{}", fmt::join(options.overrides, " ")),
+             config.source.path.string(), options.frames, u.sysname, u.machine, std::thread::hardware_concurrency(),
+             utc_now());
+  std::string header = "| run | frames | frames/s |", rule = "|---|---:|---:|";
+  for (const std::string& stage : kStages) {
+    header += fmt::format(" {} ms |", stage);
+    rule += "---:|";
+  }
+  fmt::print("{}\n{}\n", header, rule);
+  // Warm-up (shader JIT, the PRT cache, the page cache), then the measured runs.
+  run(bench_config(options, 30));
+  const PipelineMetrics full = run(config);
+  // What the issue of record compares against: the same objects without the three features whose
+  // cost is per pixel of the canvas rather than per pixel drawn.
+  const PipelineMetrics cheap = run(bench_config(
+      options, options.frames, {"render.shadows.method=\"off\"", "render.msaa_samples=1", "render.lens=\"vertex\""}));
+  const PipelineMetrics pass = run(bench_config(options, options.frames, {"render.objects=[]"}));
+  print_row("the config", full);
+  print_row("shadows off, MSAA off, render.lens = vertex", cheap);
+  print_row("pass-through (no virtual object)", pass);
+  const double full_render = mean_ms(full, "render"), cheap_render = mean_ms(cheap, "render");
+  fmt::print("\nframes/s against pass-through: {:.3f}; render ms against the cheap render: {}\n",
+             pass.fps() > 0 ? full.fps() / pass.fps() : 0,
+             cheap_render > 0 ? fmt::format("{:.2f}", full_render / cheap_render) : std::string("-"));
 
-  if (soak_seconds > 0) {
-    const Config config = bench_config(capture, 0, true);
-    PipelineRunner runner(make_source(config), make_stage_factory(), {}, config);
+  if (options.soak_seconds > 0) {
+    const Config soak = bench_config(options, 0);
+    PipelineRunner runner(make_source(soak), make_stage_factory(), {}, soak);
     runner.start();
     const auto start = std::chrono::steady_clock::now();
     long first = -1, peak = 0, last = 0;
-    fmt::print("\nsoak: {} s looped replay of the default scene\n\n| t (s) | frames | RSS (MiB) |\n|---:|---:|---:|\n",
-               soak_seconds);
-    const int step = std::max(1, soak_seconds / 10);
-    for (int t = 0; t <= soak_seconds; ++t) {
+    fmt::print("\nsoak: {} s looped replay of the config\n\n| t (s) | frames | RSS (MiB) |\n|---:|---:|---:|\n",
+               options.soak_seconds);
+    const int step = std::max(1, options.soak_seconds / 10);
+    for (int t = 0; t <= options.soak_seconds; ++t) {
       std::this_thread::sleep_until(start + std::chrono::seconds(t));
       last = resident_kib();
       peak = std::max(peak, last);
-      if (t == std::min(10, soak_seconds)) first = last;  // after warm-up
+      if (t == std::min(10, options.soak_seconds)) first = last;  // after warm-up
       if (t % step == 0) fmt::print("| {} | {} | {:.1f} |\n", t, runner.metrics().frames_out, last / 1024.0);
     }
     runner.stop();
@@ -110,10 +151,19 @@ int run_pipeline_benchmark(const PipelineOptions& options) {
 
 void add_pipeline_benchmark(CLI::App& bench) {
   CLI::App* command = bench.add_subcommand(
-      "pipeline", "per-stage time and frames/s of the default scene and of pass-through; memory over a looped replay");
+      "pipeline",
+      "per-stage time and frames/s of a config, of it with shadows, MSAA and the lens map off, and of pass-through");
   auto options = std::make_shared<PipelineOptions>();
-  command->add_option("--capture", options->capture, "the recording to replay")->type_name("DIR");
-  command->add_option("--frames", options->frames, "frames per measured run")->check(CLI::PositiveNumber);
+  command->add_option("--config", options->config, "the config to measure (its sinks are turned off)")
+      ->type_name("FILE")
+      ->capture_default_str();
+  command->add_option("--capture", options->capture, "the recording to replay (default: the config's source.path)")
+      ->type_name("DIR");
+  command->add_option("--frames", options->frames, "frames per measured run (the replay loops)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  command->add_option("--set", options->overrides, "override one config key (VALUE in TOML syntax); repeatable")
+      ->type_name("KEY=VALUE");
   command->add_option("--soak-seconds", options->soak_seconds, "then a looped replay this long, its memory every step (0: none)")
       ->type_name("S")
       ->check(CLI::NonNegativeNumber);

@@ -83,6 +83,8 @@ void RenderStage::configure_loaded(const Config& config, const std::shared_ptr<c
   settings.lens_canvas_scale = config.render.lens_canvas_scale;
   settings.rolling_shutter = config.render.rolling_shutter;
   settings.max_predicted_uncertainty_deg = config.render.max_predicted_uncertainty_deg;
+  settings.reuse_layer = config.render.reuse_layer;
+  settings.full_canvas = config.render.full_canvas;
   settings.blur = config.render.blur;
   settings.shadows = config.render.shadows;
   settings.shadow_method = config.render.shadows.method;
@@ -99,6 +101,7 @@ void RenderStage::configure_loaded(const Config& config, const std::shared_ptr<c
     warp_pass_ = std::make_unique<LensWarpPass>(session_->layer().color_format());
 
   objects_ = std::move(objects);
+  reuse_.forget();  // new objects or settings: draw again
   if (settings.lens_canvas_scale != settings_.lens_canvas_scale) warp_maps_.clear();
   settings_ = settings;
   last_error_.clear();
@@ -150,12 +153,17 @@ void RenderStage::process(FrameContext& ctx) noexcept {
       ctx.record_timing(std::string(name()), milliseconds_since(start), std::move(skip));
       return;
     }
-    draw(ctx);
-    if (ctx.virtual_layer_drawn) {
-      ctx.record_timing(std::string(name()), milliseconds_since(start));
-      last_error_.clear();
-    } else {
-      ctx.record_timing(std::string(name()), milliseconds_since(start), "objects out of view");
+    switch (draw(ctx)) {
+      case Drawn::Yes:
+        ctx.record_timing(std::string(name()), milliseconds_since(start));
+        last_error_.clear();
+        break;
+      case Drawn::Reused:
+        ctx.record_timing(std::string(name()), milliseconds_since(start), "reused: pose, light and objects unchanged");
+        break;
+      case Drawn::OutOfView:
+        ctx.record_timing(std::string(name()), milliseconds_since(start), "objects out of view");
+        break;
     }
   } catch (const std::exception& e) {
     ctx.virtual_layer_drawn = false;
@@ -168,7 +176,7 @@ void RenderStage::process(FrameContext& ctx) noexcept {
   }
 }
 
-void RenderStage::draw(FrameContext& ctx) {
+RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
   if (!ctx.camera_model) throw RenderError("the frame has no camera model");
   const CameraModel& camera = *ctx.camera_model;
   if (camera.width() != ctx.camera.width || camera.height() != ctx.camera.height)
@@ -203,7 +211,7 @@ void RenderStage::draw(FrameContext& ctx) {
     }
     if (in_view) request.objects.push_back(&object);
   }
-  if (request.objects.empty()) return;
+  if (request.objects.empty()) return Drawn::OutOfView;
   session_->make_current();
 
   // "map": draw on the pinhole canvas, in the part of it that the output rectangle samples.
@@ -220,7 +228,8 @@ void RenderStage::draw(FrameContext& ctx) {
   request.rows = {camera.fy(), camera.cy(), camera.height()};
   double angular_diameter_rad = 0;
   request.lighting = frame_lighting(ctx, angular_diameter_rad);
-  request.lighting.shadow = shadow_for(ctx, request.lighting, angular_diameter_rad, request.objects);
+  bool shadow_redrawn = false;
+  request.lighting.shadow = shadow_for(ctx, request.lighting, angular_diameter_rad, request.objects, shadow_redrawn);
   if (request.lighting.shadow) {
     // The catcher's patch joins the footprint where it is in view.
     const UploadedObject& catcher = *request.objects.back();
@@ -229,11 +238,20 @@ void RenderStage::draw(FrameContext& ctx) {
               projected_box_rect(image_camera, T_cam_world * catcher.T_world_object, catcher.bounds, kRectMarginPx))
         rect = rect.united(*r);
   }
+  if (settings_.full_canvas) rect = PixelRect::full(camera.width(), camera.height());
   request.rect = warp ? warp->canvas_rect_for(rect) : rect;
   request.image_motion_px = ctx.motion.valid() ? ctx.motion.max_image_motion_px : 0;
   request.msaa_samples = settings_.msaa_samples;
   request.rolling_shutter = settings_.rolling_shutter;
 
+  LayerReuse::Inputs inputs{ctx.camera_model, exposure_poses, request.objects, request.lighting, shadow_redrawn, rect};
+  if (settings_.reuse_layer && reuse_.can_reuse(inputs)) {
+    ctx.virtual_layer = reuse_.layer();
+    ctx.virtual_layer_drawn = true;
+    ctx.blur_method = reuse_.blur_method();
+    ctx.blur_samples = reuse_.blur_samples();
+    return Drawn::Reused;
+  }
   session_->make_current();
   VirtualLayer& layer = session_->layer();
   const LayerDrawResult drawn = drawer_->draw(layer, request, settings_.blur);
@@ -252,6 +270,8 @@ void RenderStage::draw(FrameContext& ctx) {
   ctx.virtual_layer_drawn = true;
   ctx.blur_method = std::string(blur_method_name(drawn.method));
   ctx.blur_samples = drawn.samples;
+  reuse_.remember(std::move(inputs), ctx.virtual_layer, ctx.blur_method, ctx.blur_samples);
+  return Drawn::Yes;
 }
 
 }  // namespace arpipe
@@ -299,7 +319,7 @@ Lighting RenderStage::frame_lighting(const FrameContext& ctx, double& angular_di
 }
 
 const ShadowLookup* RenderStage::shadow_for(FrameContext& ctx, const Lighting& lighting, double angular_diameter_rad,
-                                            std::vector<const UploadedObject*>& drawn) {
+                                            std::vector<const UploadedObject*>& drawn, bool& redrawn) {
   const auto start = std::chrono::steady_clock::now();
   const auto skip = [&](std::string why) -> const ShadowLookup* {
     ctx.record_timing("shadow", milliseconds_since(start), std::move(why));
@@ -330,6 +350,7 @@ const ShadowLookup* RenderStage::shadow_for(FrameContext& ctx, const Lighting& l
   if (is_variance_method(settings_.shadow_method)) caster_objects.push_back(&catcher);
   const bool drew = shadow_pass_->render(*frustum, caster_objects, angular_diameter_rad);
   drawn.push_back(&catcher);
+  redrawn = drew;
   if (drew) glFinish();  // honest timings: the work is queued until something waits
   ctx.record_timing("shadow", milliseconds_since(start), drew ? "" : "reused");
   return &shadow_pass_->lookup();

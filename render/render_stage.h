@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/pipeline/stage.h"
+#include "render/layer_reuse.h"
 #include "render/lens/lens_mode.h"
 #include "render/lens/lens_warp_map.h"
 #include "render/lens/lens_warp_pass.h"
@@ -43,6 +44,8 @@ class RenderStage final : public Stage {
   // objects, there is no pose (neither Tracking nor Predicted within
   // render.max_predicted_uncertainty_deg), or no object's box reaches into the
   // image; such frames do no GL work. Blurs by render.blur when the frame's motion asks for it.
+  // Hands the last layer on again (drawn, with the skip reason "reused: ...") when the objects, the
+  // pose over the exposure and the light are unchanged within LayerReuse's tolerances.
   void process(FrameContext& ctx) noexcept override;
 
  private:
@@ -57,15 +60,19 @@ class RenderStage final : public Stage {
     double lens_canvas_scale = 1.5;
     bool rolling_shutter = true;
     double max_predicted_uncertainty_deg = 5.0;
+    bool reuse_layer = true;
+    bool full_canvas = false;
     BlurConfig blur;
     ShadowConfig shadows;
     ShadowMethod shadow_method = ShadowMethod::Off;
   };
-  void draw(FrameContext& ctx);
+  enum class Drawn { Yes, Reused, OutOfView };
+  Drawn draw(FrameContext& ctx);
   Lighting frame_lighting(const FrameContext& ctx, double& angular_diameter_rad) const;
   // The shadow map for this frame's light, or nullptr (ctx gets a "shadow" timing saying why).
+  // redrawn: whether the map changed (a layer drawn with the old one cannot be reused).
   const ShadowLookup* shadow_for(FrameContext& ctx, const Lighting& lighting, double angular_diameter_rad,
-                                 std::vector<const UploadedObject*>& drawn);
+                                 std::vector<const UploadedObject*>& drawn, bool& redrawn);
   std::shared_ptr<const LensWarpMap> warp_map(const std::shared_ptr<const CameraModel>& camera_model);
   std::shared_ptr<const CameraModel> pinhole_core(const std::shared_ptr<const CameraModel>& camera_model);
 
@@ -78,6 +85,7 @@ class RenderStage final : public Stage {
   PerModelCache<LensWarpMap> warp_maps_;
   PerModelCache<CameraModel> pinhole_cores_;  // render.lens = "undistort": what the output sees
   std::vector<UploadedObject> objects_;
+  LayerReuse reuse_;
   Settings settings_;
   std::string last_error_;  // logged once per distinct message, not once per frame
 };

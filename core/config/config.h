@@ -321,6 +321,12 @@ struct RenderConfig {
   // A predicted pose (track.max_predicted_frames) is drawn only while its stated uncertainty is at
   // most this many degrees: past it the object would stand visibly in the wrong place.
   double max_predicted_uncertainty_deg = 5.0;
+  // Hand the last virtual layer on when the pose over the exposure, the light and the objects are
+  // unchanged within render/layer_reuse.h's tolerances (a still camera over a still scene).
+  bool reuse_layer = true;
+  // Every pass over the whole image instead of the objects' footprint: the same picture at the
+  // whole frame's cost, for checking the footprint (tests/render/footprint_test.cpp).
+  bool full_canvas = false;
   BlurConfig blur;
   ShadowConfig shadows;
   PrtConfig prt;
@@ -352,6 +358,8 @@ void visit(V& v, RenderConfig& s) {
   v.key("rolling_shutter", s.rolling_shutter, "draw each row with its own exposure's pose when the readout time is non-zero");
   v.key("max_predicted_uncertainty_deg", s.max_predicted_uncertainty_deg, NumberRange::closed(0, 180).in("degrees"),
         "a predicted pose less certain than this is not drawn");
+  v.key("reuse_layer", s.reuse_layer, "hand the last virtual layer on while pose, light and objects are unchanged");
+  v.key("full_canvas", s.full_canvas, "every pass over the whole image, not the objects' footprint (for checking it)");
   v.section("blur", s.blur, "motion blur of the virtual layer over each exposure");
   v.section("shadows", s.shadows, "shadows of the virtual objects, on themselves and on the real ground");
   v.section("prt", s.prt, "precomputed radiance transfer, baked once per mesh (arpipe bake)");
