@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "apps/cli/command_line.h"
+#include "core/geometry/math_constants.h"
 #include "bench/benchmarks.h"
 #include "core/geometry/vec.h"
 #include "core/sh/sh_basis.h"
@@ -27,7 +28,6 @@
 namespace arpipe {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
 constexpr int kMaxBands = 7;
 
 using Clock = std::chrono::steady_clock;

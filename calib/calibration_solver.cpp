@@ -1,6 +1,7 @@
 // The calibration solve: a seed computed here (mrcal 2.2 seeds only in Python), then mrcal's staged
 // optimisation in the order mrcal-calibrate-cameras runs it (solve_initial() and the final solve).
 #include "calib/calibration_solver.h"
+#include "core/geometry/math_constants.h"
 
 #include <fmt/format.h>
 
@@ -21,8 +22,6 @@ namespace {
 constexpr int kMinViews = 4;            // mrcal's solve and our seed need at least this many
 constexpr int kMinPointsPerView = 4;    // PnP on a plane (IPPE) needs 4
 constexpr double kFrontoParallelDeg = 10.0;
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kPi = 3.14159265358979323846;
 const char* const kSplinedBare = "LENSMODEL_SPLINED_STEREOGRAPHIC";
 
 double seconds_since(std::chrono::steady_clock::time_point start) {

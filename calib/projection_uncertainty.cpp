@@ -2,6 +2,7 @@
 // _projection_uncertainty(), _projection_uncertainty_rotationonly(), _propagate_calibration_uncertainty())
 // in C++, for the monocular problem the solver sets up (camera at the reference, one frame per view).
 #include "calib/projection_uncertainty.h"
+#include "core/geometry/math_constants.h"
 
 extern "C" {
 #include <mrcal/mrcal.h>
@@ -23,7 +24,6 @@ namespace arpipe::calib {
 
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 using RowMatrix2X = Eigen::Matrix<double, 2, Eigen::Dynamic, Eigen::RowMajor>;
 

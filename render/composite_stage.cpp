@@ -21,7 +21,7 @@ namespace arpipe {
 namespace {
 
 // Pixel for pixel: GL rows are image rows in both textures and in the output.
-constexpr std::string_view kFragmentShader = R"glsl(#version 300 es
+constexpr std::string_view kCompositeFragmentShader = R"glsl(#version 300 es
 precision highp float;
 uniform highp sampler2D u_virtual_layer;  // linear, premultiplied alpha
 uniform highp sampler2D u_camera;         // the camera's bytes, through its response
@@ -75,7 +75,7 @@ void CompositeStage::configure(const Config& config) {
   const LensMode lens = config.render.lens;
   session_->make_current();
   if (program_.id() == 0) {
-    program_ = GlProgram("compositing", kFullScreenTriangleVertexShader, kFragmentShader);
+    program_ = GlProgram("compositing", kFullScreenTriangleVertexShader, kCompositeFragmentShader);
     empty_vertex_array_ = GlVertexArray::create();
     glUseProgram(program_.id());
     glUniform1i(program_.uniform("u_virtual_layer"), 0);

@@ -2,6 +2,7 @@
 // position, Hermite in each segment's tangent space of SO(3)), or a seeded random orbit whose
 // time scale is solved so that the worst motion blur over the capture is the requested one.
 #include "capture/sim/camera_trajectory.h"
+#include "core/geometry/math_constants.h"
 
 #include <algorithm>
 #include <array>
@@ -18,7 +19,6 @@ namespace arpipe::sim {
 
 namespace {
 
-constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
 Mat3 from_columns(const Vec3& x, const Vec3& y, const Vec3& z) {
   return {{{x[0], y[0], z[0]}, {x[1], y[1], z[1]}, {x[2], y[2], z[2]}}};

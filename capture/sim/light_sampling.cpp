@@ -1,5 +1,6 @@
 // Direction sampling for the simulator's lighting.
 #include "capture/sim/light_sampling.h"
+#include "core/geometry/math_constants.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +9,6 @@
 namespace arpipe::sim {
 
 namespace {
-constexpr double kTwoPi = 2 * std::numbers::pi;
 }
 
 Frame3 frame_around(const Vec3& n) {

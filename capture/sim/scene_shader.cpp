@@ -5,6 +5,7 @@
 // shows the sky and light discs along its own reflection, cast no further; textures cover planes
 // only; a mesh's albedo is the material's times its glTF part colour, shaded with its normals.
 #include "capture/sim/scene_shader.h"
+#include "core/geometry/math_constants.h"
 
 #include <fmt/format.h>
 
@@ -25,7 +26,6 @@ namespace arpipe::sim {
 
 namespace {
 
-constexpr double kPi = std::numbers::pi;
 
 // Shadow and mirror rays start this far off the surface, along its normal (relative to the size of
 // the coordinates and of the distance travelled, because triangles and Embree's traversal are in

@@ -1,5 +1,6 @@
 // The simulator's plane textures and sky.
 #include "capture/sim/sim_textures.h"
+#include "core/geometry/math_constants.h"
 #include "core/image/srgb.h"
 
 #include <apriltag/apriltag.h>
@@ -28,7 +29,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr double kPi = std::numbers::pi;
 
 // Decoding goes to the decoder of the format read_image_header identified, never to OpenCV's
 // signature probing: that handed a JPEG with "DICM" at byte 128 to its DICOM decoder, which

@@ -612,6 +612,11 @@ void visit(V& v, Config& s) {
   v.section("pipeline", s.pipeline, "threads and limits");
 }
 
+// The config's file for messages, or "config" when it was not read from one.
+inline std::string config_source_name(const Config& config) {
+  return config.file.empty() ? std::string("config") : config.file.string();
+}
+
 // Loads a config file. Throws ConfigError naming the file and the place on any problem:
 // unreadable file, TOML syntax, unknown key, wrong type, value out of range.
 // overrides: "section.key=value" assignments (value in TOML syntax; a bare word such as fast or

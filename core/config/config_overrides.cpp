@@ -1,6 +1,7 @@
 // `--set section.key=value` overrides: each is parsed as one TOML assignment and merged into the
 // parsed file, so the schema walk checks it like the file's own keys.
 #include "core/config/config_overrides.h"
+#include "core/config/toml_text.h"
 
 #include <fmt/format.h>
 
@@ -15,12 +16,6 @@
 namespace arpipe {
 
 namespace {
-
-std::string_view trim(std::string_view text) {
-  while (!text.empty() && std::isspace(static_cast<unsigned char>(text.front()))) text.remove_prefix(1);
-  while (!text.empty() && std::isspace(static_cast<unsigned char>(text.back()))) text.remove_suffix(1);
-  return text;
-}
 
 [[noreturn]] void override_error(const std::string& label, const std::string& what) {
   throw TomlInputError(fmt::format("{}: {}", label, what));
@@ -121,8 +116,8 @@ void apply_override(toml::table& root, const std::string& assignment) {
   const std::string label = override_label(assignment);
   const size_t equals = assignment.find('=');
   if (equals == std::string::npos) override_error(label, "expected section.key=value");
-  const std::string_view key = trim(std::string_view(assignment).substr(0, equals));
-  const std::string_view value = trim(std::string_view(assignment).substr(equals + 1));
+  const std::string_view key = trim_space(std::string_view(assignment).substr(0, equals));
+  const std::string_view value = trim_space(std::string_view(assignment).substr(equals + 1));
   size_t start = 0;
   while (true) {
     const size_t dot = key.find('.', start);

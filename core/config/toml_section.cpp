@@ -1,5 +1,6 @@
 // TomlSection: typed reads over one toml++ table, remembered for the stray-key check.
 #include "core/config/toml_section.h"
+#include "core/config/toml_text.h"
 
 #include <fmt/format.h>
 
@@ -16,12 +17,6 @@ namespace arpipe {
 namespace {
 
 constexpr std::string_view kOverridePrefix = "override '";
-
-std::string_view trim(std::string_view text) {
-  while (!text.empty() && std::isspace(static_cast<unsigned char>(text.front()))) text.remove_prefix(1);
-  while (!text.empty() && std::isspace(static_cast<unsigned char>(text.back()))) text.remove_suffix(1);
-  return text;
-}
 
 std::string join(const std::vector<std::string>& items) {
   std::string out;
@@ -72,20 +67,20 @@ std::string key_on_line(std::string_view text, uint32_t line) {
   for (uint32_t number = 1; begin <= text.size(); ++number) {
     size_t end = text.find('\n', begin);
     if (end == std::string_view::npos) end = text.size();
-    const std::string_view content = trim(text.substr(begin, end - begin));
+    const std::string_view content = trim_space(text.substr(begin, end - begin));
     if (number == line) {
       const size_t equals = content.find('=');
-      const std::string key(trim(content.substr(0, equals == std::string_view::npos ? 0 : equals)));
+      const std::string key(trim_space(content.substr(0, equals == std::string_view::npos ? 0 : equals)));
       if (key.empty()) return table;
       return table.empty() ? key : table + "." + key;
     }
     if (content.starts_with("[[")) {
       const size_t close = content.find("]]");
-      const std::string name(trim(content.substr(2, close == std::string_view::npos ? 0 : close - 2)));
+      const std::string name(trim_space(content.substr(2, close == std::string_view::npos ? 0 : close - 2)));
       table = fmt::format("{}[{}]", name, array_counts[name]++);
     } else if (content.starts_with("[")) {
       const size_t close = content.find(']');
-      table = std::string(trim(content.substr(1, close == std::string_view::npos ? 0 : close - 1)));
+      table = std::string(trim_space(content.substr(1, close == std::string_view::npos ? 0 : close - 1)));
     }
     if (end == text.size()) break;
     begin = end + 1;

@@ -16,6 +16,8 @@ std::string toml_float(double value);
 // Text for a message: control characters shown as escapes, so a value cannot start a new line.
 std::string printable(std::string_view text);
 
+// The text without leading and trailing white space.
+std::string_view trim_space(std::string_view text);
 // A range bound for messages and help text: 4 -> "4", 0.95 -> "0.95", 1e12 -> "1e12".
 std::string bound_text(double value);
 

@@ -1,6 +1,7 @@
 // Pixel <-> direction maps and texel solid angles of the four light-probe layouts (conventions in
 // the header). Inverses use atan2 forms so that directions near the poles keep full precision.
 #include "core/environment/environment_layout.h"
+#include "core/geometry/math_constants.h"
 
 #include <fmt/format.h>
 
@@ -14,7 +15,6 @@
 namespace arpipe {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
 
 // ---- disk layouts ----------------------------------------------------------------------------
 

@@ -1,6 +1,7 @@
 // CameraModel over mrcal's C API: mrcal reads the .cameramodel files and does every projection.
 // Before mrcal sees a file, a small scanner checks it, so a bad file gets a message with its line.
 #include "core/geometry/camera_model.h"
+#include "core/geometry/math_constants.h"
 
 extern "C" {
 #include <mrcal/mrcal.h>
@@ -30,7 +31,6 @@ struct CameraModel::Mrcal {
 
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 std::string supported_lensmodels() {
   std::string names;

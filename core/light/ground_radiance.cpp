@@ -1,5 +1,6 @@
 // The ground's brightness around the anchor (see ground_radiance.h).
 #include "core/light/ground_radiance.h"
+#include "core/geometry/math_constants.h"
 
 #include <algorithm>
 #include <array>
@@ -16,7 +17,6 @@ namespace {
 // stand on; the median copes with real objects and shadows on part of it.
 constexpr double kRingInner = 0.09, kRingOuter = 0.25;
 constexpr int kRingSamples = 96;
-constexpr double kPi = std::numbers::pi;
 
 }  // namespace
 

@@ -1,4 +1,5 @@
 #include "core/probe/diffuse_probe.h"
+#include "core/geometry/math_constants.h"
 
 #include <algorithm>
 #include <array>
@@ -14,7 +15,6 @@ namespace arpipe {
 
 namespace {
 
-constexpr double kPi = std::numbers::pi;
 constexpr int kP = 5;  // E, a0, ax, ay, az
 using Vec5 = std::array<double, kP>;
 

@@ -1,4 +1,5 @@
 #include "core/probe/mirror_probe.h"
+#include "core/geometry/math_constants.h"
 
 #include <algorithm>
 #include <array>
@@ -12,7 +13,6 @@ namespace arpipe {
 
 namespace {
 
-constexpr double kPi = std::numbers::pi;
 
 struct Sample {
   Vec3 dir;      // reflected direction, world

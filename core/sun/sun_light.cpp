@@ -1,5 +1,6 @@
 // The sun's light from place and time (see sun_light.h).
 #include "core/sun/sun_light.h"
+#include "core/geometry/math_constants.h"
 
 #include <fmt/format.h>
 
@@ -15,7 +16,6 @@
 namespace arpipe {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
 
 // SH (Green's order) of radiance `up` over the upper hemisphere and `down` below: only the
 // constant and the z term survive (the l = 2, m = 0 term integrates to zero over a hemisphere).

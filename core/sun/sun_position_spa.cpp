@@ -1,6 +1,7 @@
 // NREL SPA, written from the paper (Reda & Andreas 2004/2008), not from NREL's spa.c (whose
 // licence forbids redistribution). Steps are numbered as in the paper's section 3.
 #include "core/sun/sun_position_spa.h"
+#include "core/geometry/math_constants.h"
 
 #include <fmt/format.h>
 
@@ -13,7 +14,6 @@ namespace arpipe {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = kPi / 180.0;
 
 double rad(double deg) { return deg * kDeg; }

@@ -26,10 +26,6 @@ double binomial(int n, int k) {
   return result;
 }
 
-std::string config_source(const Config& config) {
-  return config.file.empty() ? std::string("config") : config.file.string();
-}
-
 }  // namespace
 
 struct TagDetector::Impl {
@@ -45,7 +41,7 @@ struct TagDetector::Impl {
 
 TagDetector::TagDetector(const Config& config) : impl_(std::make_unique<Impl>()) {
   const TrackConfig& track = config.track;
-  const std::string source = config_source(config);
+  const std::string source = config_source_name(config);
   if (!is_tag_family(track.family)) {
     throw ConfigError(fmt::format("{}: track.family: unknown AprilTag family '{}' (expected one of: {})", source,
                                   track.family, joined_tag_family_names()));

@@ -24,16 +24,12 @@
 namespace arpipe {
 namespace {
 
-std::string config_source(const Config& config) {
-  return config.file.empty() ? std::string("config") : config.file.string();
-}
-
 bool finite(const Vec3& v) { return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]); }
 
 // Checks what the detector does not: the bundle layout and the acceptance thresholds.
 void validate(const Config& config, const TagDetector& detector) {
   const TrackConfig& track = config.track;
-  const std::string source = config_source(config);
+  const std::string source = config_source_name(config);
   if (track.bundle.empty()) {
     throw ConfigError(fmt::format("{}: track.bundle: expected at least one tag", source));
   }

@@ -7,7 +7,7 @@
 namespace arpipe {
 namespace {
 
-constexpr std::string_view kFragmentShader = R"glsl(#version 300 es
+constexpr std::string_view kAccumulateFragmentShader = R"glsl(#version 300 es
 precision highp float;
 uniform highp sampler2D u_source;
 uniform float u_weight;
@@ -27,7 +27,7 @@ GLenum sum_format(const EglContext& context) {
 
 AccumulationPass::AccumulationPass(const EglContext& context)
     : format_(sum_format(context)),
-      program_("blur accumulation", kFullScreenTriangleVertexShader, kFragmentShader),
+      program_("blur accumulation", kFullScreenTriangleVertexShader, kAccumulateFragmentShader),
       empty_vertex_array_(GlVertexArray::create()) {
   glUseProgram(program_.id());
   glUniform1i(program_.uniform("u_source"), 0);

@@ -18,7 +18,7 @@ namespace {
 // image (render.lens_canvas_scale > 1). 2 x 2 taps cover a footprint of up to 4 texels a side
 // (each bilinear tap spans two), all that kMaxCanvasScale makes; measured: 1 tap at scale 2 moves
 // small shapes twice as far.
-constexpr std::string_view kFragmentShader = R"glsl(#version 300 es
+constexpr std::string_view kLensWarpFragmentShader = R"glsl(#version 300 es
 precision highp float;
 uniform highp sampler2D u_canvas;
 uniform highp sampler2D u_map;
@@ -50,7 +50,7 @@ void main() {
 
 LensWarpPass::LensWarpPass(GLenum output_format)
     : output_format_(output_format),
-      program_("lens warp", kFullScreenTriangleVertexShader, kFragmentShader),
+      program_("lens warp", kFullScreenTriangleVertexShader, kLensWarpFragmentShader),
       empty_vertex_array_(GlVertexArray::create()) {
   glUseProgram(program_.id());
   glUniform1i(program_.uniform("u_canvas"), 0);
