@@ -18,6 +18,7 @@
 #include "apps/cli/command_line.h"
 #include "apps/common/pipeline_assembly.h"
 #include "bench/benchmarks.h"
+#include "bench/pipeline_run.h"
 #include "core/log.h"
 
 namespace arpipe {
@@ -52,25 +53,13 @@ Config bench_config(const PipelineOptions& options, int64_t frames, const std::v
   return load_config(options.config, overrides);
 }
 
-PipelineMetrics run(const Config& config) {
-  PipelineRunner runner(make_source(config), make_stage_factory(), {}, config);
-  runner.start();
-  runner.wait();
-  return runner.metrics();
-}
-
-double mean_ms(const PipelineMetrics& m, const std::string& stage) {
-  const auto it = m.stages.find(stage);
-  return it == m.stages.end() || it->second.runs == 0 ? 0 : it->second.total_ms / double(it->second.runs);
-}
-
 // "2.31", with the skips that went into the mean ("2.31 (12 skipped)"); "-" when it never ran.
 std::string stage_cell(const PipelineMetrics& m, const std::string& stage) {
   const auto it = m.stages.find(stage);
   if (it == m.stages.end() || it->second.runs == 0) return "-";
   uint64_t skipped = 0;
   for (const auto& [reason, count] : it->second.skips) skipped += count;
-  return fmt::format("{:.2f}{}", mean_ms(m, stage), skipped ? fmt::format(" ({} skipped)", skipped) : "");
+  return fmt::format("{:.2f}{}", mean_stage_ms(m, stage), skipped ? fmt::format(" ({} skipped)", skipped) : "");
 }
 
 // The stages in pipeline order; "shadow" is part of "render" (its shadow map).
@@ -108,17 +97,17 @@ int run_pipeline_benchmark(const PipelineOptions& options) {
   }
   fmt::print("{}\n{}\n", header, rule);
   // Warm-up (shader JIT, the PRT cache, the page cache), then the measured runs.
-  run(bench_config(options, 30));
-  const PipelineMetrics full = run(config);
+  run_pipeline(bench_config(options, 30));
+  const PipelineMetrics full = run_pipeline(config);
   // What the issue of record compares against: the same objects without the three features whose
   // cost is per pixel of the canvas rather than per pixel drawn.
-  const PipelineMetrics cheap = run(bench_config(
+  const PipelineMetrics cheap = run_pipeline(bench_config(
       options, options.frames, {"render.shadows.method=\"off\"", "render.msaa_samples=1", "render.lens=\"vertex\""}));
-  const PipelineMetrics pass = run(bench_config(options, options.frames, {"render.objects=[]"}));
+  const PipelineMetrics pass = run_pipeline(bench_config(options, options.frames, {"render.objects=[]"}));
   print_row("the config", full);
   print_row("shadows off, MSAA off, render.lens = vertex", cheap);
   print_row("pass-through (no virtual object)", pass);
-  const double full_render = mean_ms(full, "render"), cheap_render = mean_ms(cheap, "render");
+  const double full_render = mean_stage_ms(full, "render"), cheap_render = mean_stage_ms(cheap, "render");
   fmt::print("\nframes/s against pass-through: {:.3f}; render ms against the cheap render: {}\n",
              pass.fps() > 0 ? full.fps() / pass.fps() : 0,
              cheap_render > 0 ? fmt::format("{:.2f}", full_render / cheap_render) : std::string("-"));

@@ -209,7 +209,7 @@ TEST_F(ArpipeCli, VersionAndHelpOfEveryCommand) {
     EXPECT_NE(help.find("Usage: arpipe " + command), std::string::npos) << help;
   }
   if (!benchmarks_built()) return;
-  for (const char* bench : {"pipeline", "pose", "sim-render", "blur", "shadows", "probe", "sun", "capture-path",
+  for (const char* bench : {"pipeline", "scaling", "pose", "sim-render", "blur", "shadows", "probe", "sun", "capture-path",
                             "calib-corners", "calib-solve", "sh", "prt"}) {
     std::string help;
     EXPECT_EQ(run({"bench", bench, "--help"}, &help, &err), 0) << bench << ": " << err;
