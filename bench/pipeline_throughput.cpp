@@ -4,6 +4,7 @@
 // `arpipe bench pipeline [--config FILE] [--capture DIR] [--frames N] [--set KEY=VALUE]...
 // [--soak-seconds S]` prints a markdown table for docs/BENCHMARKS.md. Timings depend on the
 // machine; compare the rows of one run with each other, not with another machine's.
+#include <fmt/chrono.h>
 #include <fmt/format.h>
 #include <sys/utsname.h>
 
@@ -71,15 +72,6 @@ void print_row(const std::string& name, const PipelineMetrics& m) {
   fmt::print("| {} | {} | {:.1f} |{}\n", name, m.frames_out, m.fps(), cells);
 }
 
-std::string utc_now() {
-  const std::time_t now = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&now, &tm);
-  char text[32];
-  std::strftime(text, sizeof text, "%Y-%m-%d %H:%M UTC", &tm);
-  return text;
-}
-
 int run_pipeline_benchmark(const PipelineOptions& options) {
   log::set_max_level(log::Level::Warning);
   utsname u{};
@@ -89,7 +81,7 @@ int run_pipeline_benchmark(const PipelineOptions& options) {
   fmt::print("config {}{}, capture {}, {} frames per run; {} {}, {} hardware threads; {}\n\n", options.config,
              options.overrides.empty() ? "" : " with --set " + fmt::format("{}", fmt::join(options.overrides, " ")),
              config.source.path.string(), options.frames, u.sysname, u.machine, std::thread::hardware_concurrency(),
-             utc_now());
+             fmt::format("{:%Y-%m-%d %H:%M} UTC", fmt::gmtime(std::time(nullptr))));
   std::string header = "| run | frames | frames/s |", rule = "|---|---:|---:|";
   for (const std::string& stage : kStages) {
     header += fmt::format(" {} ms |", stage);

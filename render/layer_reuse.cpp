@@ -50,10 +50,7 @@ double max_corner_motion_px(const CameraModel& camera, const std::vector<const U
   double most = 0;
   for (const UploadedObject* object : objects) {
     const SE3 a = T_cam_world_a * object->T_world_object, b = T_cam_world_b * object->T_world_object;
-    for (int i = 0; i < 8; ++i) {
-      const Bounds& box = object->bounds;
-      const Vec3 corner{(i & 1) ? box.max[0] : box.min[0], (i & 2) ? box.max[1] : box.min[1],
-                        (i & 4) ? box.max[2] : box.min[2]};
+    for (const Vec3& corner : box_corners(object->bounds)) {
       const Vec3 pa = a * corner, pb = b * corner;
       const double depth = std::min(pa[2], pb[2]);
       if (depth < kNearestDepthM) {

@@ -19,13 +19,11 @@ constexpr int kSamplesPerEdge = 16;
 
 std::optional<PixelRect> projected_box_rect(const CameraModel& camera, const SE3& T_cam_object, const Bounds& box,
                                             double margin_px) {
-  std::array<Vec3, 8> corners;
+  std::array<Vec3, 8> corners = box_corners(box);
   int behind = 0;
-  for (int i = 0; i < 8; ++i) {
-    const Vec3 corner{(i & 1) ? box.max[0] : box.min[0], (i & 2) ? box.max[1] : box.min[1],
-                      (i & 4) ? box.max[2] : box.min[2]};
-    corners[static_cast<size_t>(i)] = T_cam_object * corner;
-    if (corners[static_cast<size_t>(i)][2] <= kNearPlaneM) ++behind;
+  for (Vec3& corner : corners) {
+    corner = T_cam_object * corner;
+    if (corner[2] <= kNearPlaneM) ++behind;
   }
   if (behind == 8) return std::nullopt;
   const PixelRect image = PixelRect::full(camera.width(), camera.height());

@@ -22,6 +22,14 @@ struct Bounds {
   Vec3 max{0, 0, 0};
 };
 
+// The box's 8 corners; bit 0 of the index picks max x, bit 1 max y, bit 2 max z.
+inline std::array<Vec3, 8> box_corners(const Bounds& box) {
+  std::array<Vec3, 8> out{};
+  for (size_t i = 0; i < 8; ++i)
+    out[i] = {(i & 1) ? box.max[0] : box.min[0], (i & 2) ? box.max[1] : box.min[1], (i & 4) ? box.max[2] : box.min[2]};
+  return out;
+}
+
 struct Mesh {
   std::vector<float> positions;  // x, y, z per vertex
   std::vector<float> normals;    // unit, x, y, z per vertex

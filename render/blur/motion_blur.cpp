@@ -22,13 +22,6 @@ int samples_for_motion(double motion_px, int lowest, int highest) {
   return std::clamp(static_cast<int>(std::ceil(motion_px)), lowest, highest);
 }
 
-std::array<Vec3, 8> box_corners(const Bounds& box) {
-  std::array<Vec3, 8> out{};
-  for (int i = 0; i < 8; ++i)
-    out[i] = {(i & 1) ? box.max[0] : box.min[0], (i & 2) ? box.max[1] : box.min[1], (i & 4) ? box.max[2] : box.min[2]};
-  return out;
-}
-
 std::vector<ObjectAtInstant> objects_at(const LayerDrawRequest& request, double exposure_fraction) {
   static const ShutterMotion kNoMotion;
   const ShutterMotion& motion = request.motion ? *request.motion : kNoMotion;

@@ -9,14 +9,6 @@
 namespace arpipe {
 namespace {
 
-std::array<Vec3, 8> box_corners(const Bounds& b) {
-  std::array<Vec3, 8> out{};
-  for (int i = 0; i < 8; ++i)
-    out[static_cast<size_t>(i)] = {(i & 1) ? b.max[0] : b.min[0], (i & 2) ? b.max[1] : b.min[1],
-                                   (i & 4) ? b.max[2] : b.min[2]};
-  return out;
-}
-
 // An orthonormal frame whose z is the light direction; x is kept horizontal where possible so the
 // map's texels line up with the ground.
 Mat3 light_rotation(const Vec3& z) {
