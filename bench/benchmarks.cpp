@@ -6,6 +6,7 @@ namespace arpipe {
 void add_benchmarks(CLI::App& bench) {
   add_pipeline_benchmark(bench);
   add_scaling_benchmark(bench);
+  add_latency_benchmark(bench);
   add_pose_benchmark(bench);
   add_sim_render_benchmark(bench);
   add_blur_benchmark(bench);

@@ -12,6 +12,7 @@ void add_benchmarks(CLI::App& bench);
 
 void add_pipeline_benchmark(CLI::App& bench);       // pipeline: per-stage time, frames/s, memory (pipeline_throughput.cpp)
 void add_scaling_benchmark(CLI::App& bench);        // scaling: cost against objects and frame size (pipeline_scaling.cpp)
+void add_latency_benchmark(CLI::App& bench);        // latency: live outputs' cost and end-to-end latency (live_outputs.cpp)
 void add_pose_benchmark(CLI::App& bench);           // pose: tracking time against pose error (pose_accuracy.cpp)
 void add_sim_render_benchmark(CLI::App& bench);     // sim-render: simulator time against its noise (sim_render_speed.cpp)
 void add_blur_benchmark(CLI::App& bench);           // blur: motion-blur methods, time against error (blur_methods.cpp)

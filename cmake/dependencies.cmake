@@ -17,6 +17,7 @@ pkg_check_modules(LIBCAMERA REQUIRED IMPORTED_TARGET libcamera)  # live cameras 
 pkg_check_modules(TURBOJPEG REQUIRED IMPORTED_TARGET libturbojpeg)  # MJPEG from UVC webcams
 pkg_check_modules(OPENEXR REQUIRED IMPORTED_TARGET OpenEXR)  # HDR light probes (.exr)
 pkg_check_modules(XXHASH REQUIRED IMPORTED_TARGET libxxhash)  # the PRT cache key: a hash of the mesh content
+pkg_check_modules(MICROHTTPD REQUIRED IMPORTED_TARGET libmicrohttpd)  # the live HTTP outputs (preview, MJPEG, metrics)
 
 # mrcal ships no pkg-config or CMake file; -lmrcal pulls in libdogleg and CHOLMOD.
 find_library(MRCAL_LIBRARY mrcal REQUIRED)

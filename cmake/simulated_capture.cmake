@@ -23,11 +23,15 @@ function(arpipe_simulated_capture target scene out_dir)
   else()
     set(simulate arpipe)
   endif()
+  # Simulated again when the simulator's code or the scene changes, not on every relink of arpipe
+  # (a new subcommand would otherwise re-simulate every capture, minutes each). A change in core
+  # that the simulator uses without recompiling (rare) needs the capture deleted by hand.
   add_custom_command(
     OUTPUT ${out_dir}/frames.jsonl
     COMMAND ${CMAKE_COMMAND} -E rm -rf ${out_dir}
     COMMAND ${simulate} simulate --scene ${scene_file} --out ${out_dir}
-    DEPENDS arpipe ${scene_file}
+    DEPENDS $<TARGET_FILE:arpipe_sim> $<TARGET_FILE:arpipe_recording> ${scene_file}
     COMMENT "Simulating ${out_dir} (configs/sim/${scene}.toml)")
   add_custom_target(${target} ${ARGN} DEPENDS ${out_dir}/frames.jsonl)
+  add_dependencies(${target} arpipe)
 endfunction()

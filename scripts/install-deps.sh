@@ -17,6 +17,8 @@ packages=(
   libopenexr-dev libxxhash-dev
   # live cameras: libcamera (ISP pipelines, Raspberry Pi), libjpeg-turbo (MJPEG from UVC webcams)
   libcamera-dev libturbojpeg0-dev
+  # live outputs: the HTTP preview, MJPEG, snapshots, state and Prometheus metrics
+  libmicrohttpd-dev
   # render: EGL + GLES 3 on Mesa (llvmpipe when there is no GPU)
   libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri libgbm1
   libtinygltf-dev libembree-dev libstb-dev libpng-dev
@@ -26,6 +28,9 @@ packages=(
   mrcal python3-mrcal
   # checking the Y4M output plays
   ffmpeg
+  # the live outputs' tests: the preview page in a real headless browser, promtool (Prometheus'
+  # own checker) on /metrics
+  chromium-headless-shell prometheus
 )
 
 sudo_cmd=()

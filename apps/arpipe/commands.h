@@ -24,6 +24,7 @@ void add_sun_command(CLI::App& arpipe);       // arpipe sun --lat DEG --lon DEG 
 void add_cameras_command(CLI::App& arpipe);   // arpipe cameras [--v4l2-only | --libcamera-only] [DEVICE]...
 void add_record_command(CLI::App& arpipe);    // arpipe record --camera CAMERA --out DIR [--frames N | --seconds S] ...
 void add_config_command(CLI::App& arpipe);    // arpipe config --defaults | --check FILE
+void add_ctl_command(CLI::App& arpipe);       // arpipe ctl [--socket PATH] status | reload | set K=V... | snapshot FILE | record start DIR | record stop
 
 // Every command, in the order `arpipe --help` lists them.
 using AddCommand = void (*)(CLI::App& arpipe);
@@ -31,6 +32,7 @@ inline constexpr AddCommand kCommands[] = {
     add_inspect_command, add_replay_command, add_simulate_command, add_calib_command,
     add_board_command,   add_bench_command,  add_sh_command,       add_bake_command,
     add_sun_command,     add_cameras_command, add_record_command,  add_config_command,
+    add_ctl_command,
 };
 
 }  // namespace arpipe

@@ -8,6 +8,7 @@
 
 #include <atomic>
 #include <exception>
+#include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
@@ -30,6 +31,8 @@ struct BackgroundReloads::Shared {
   SystemdNotifier systemd;
   std::atomic<uint64_t> newest_ticket{0};
   std::atomic<int> running{0};
+  std::mutex mutex;
+  std::vector<std::string> applied_sets;  // from arpipe ctl, applied; kept for later reloads
 };
 
 BackgroundReloads::BackgroundReloads(const DaemonOptions& options, const Config& started,
@@ -41,21 +44,23 @@ BackgroundReloads::BackgroundReloads(const DaemonOptions& options, const Config&
   shared_->systemd = systemd;
 }
 
-void BackgroundReloads::start() {
+void BackgroundReloads::start(const std::string& why, std::vector<std::string> extra, Done done) {
   shared_->systemd.reloading();
   // The ticket is taken now, before anything is read: it supersedes every older reload at once.
   const uint64_t ticket = shared_->reloader->new_ticket();
   const bool superseding = shared_->running.load() > 0;
   shared_->newest_ticket = ticket;
-  log::info("SIGHUP: reloading {}{}", shared_->options.config_path.string(),
+  log::info("{}: reloading {}{}", why, shared_->options.config_path.string(),
             superseding ? " (supersedes the reload still loading)" : "");
   ++shared_->running;
-  std::thread([s = shared_, ticket] { reload(s, ticket); }).detach();
+  std::thread([s = shared_, ticket, extra = std::move(extra), done = std::move(done)] { reload(s, ticket, extra, done); })
+      .detach();
 }
 
 bool BackgroundReloads::any_running() const { return shared_->running.load() > 0; }
 
-void BackgroundReloads::reload(const std::shared_ptr<Shared>& s, uint64_t ticket) {
+void BackgroundReloads::reload(const std::shared_ptr<Shared>& s, uint64_t ticket, const std::vector<std::string>& extra,
+                               const Done& done) {
   // Below the pipeline's threads, and so are the bake's workers it starts (they inherit it): the
   // frames keep their share of the CPU while a reload loads.
   setpriority(PRIO_PROCESS, static_cast<id_t>(gettid()), kReloadNiceness);
@@ -64,7 +69,13 @@ void BackgroundReloads::reload(const std::shared_ptr<Shared>& s, uint64_t ticket
   bool accepted = false;
   std::vector<std::string> applied;
   try {
-    Config next = load_config(s->options.config_path, s->options.overrides);
+    std::vector<std::string> overrides = s->options.overrides;
+    {
+      std::lock_guard lock(s->mutex);
+      overrides.insert(overrides.end(), s->applied_sets.begin(), s->applied_sets.end());
+    }
+    overrides.insert(overrides.end(), extra.begin(), extra.end());
+    Config next = load_config(s->options.config_path, overrides);
     // Refused whole, before anything is loaded: applying the rest would leave a config running
     // that is neither the old one nor the file's.
     if (const std::vector<std::string> restart = keys_needing_restart(s->started, next); !restart.empty()) {
@@ -75,21 +86,29 @@ void BackgroundReloads::reload(const std::shared_ptr<Shared>& s, uint64_t ticket
       if (accepted) {
         applied = changed_parts(replaced, next);
         log::set_max_level(next.pipeline.log_level);
+        std::lock_guard lock(s->mutex);
+        s->applied_sets.insert(s->applied_sets.end(), extra.begin(), extra.end());
       }
     }
   } catch (const std::exception& e) {
     error = e.what();
   }
   const bool newest = s->newest_ticket.load() == ticket;
+  std::string message;
   if (accepted && applied.empty())
-    log::info("reload applied: no key changed; the stages read their files again");
+    message = "reload applied: no key changed; the stages read their files again";
   else if (accepted)
-    log::info("reload applied: {}", fmt::join(applied, ", "));
+    message = fmt::format("reload applied: {}", fmt::join(applied, ", "));
   else if (error == StageReloader::kSuperseded)
-    log::info("reload of {} superseded by a newer SIGHUP: not applied", path);
+    message = fmt::format("reload of {} superseded by a newer reload: not applied", path);
   else
-    log::error("reload refused: {}; the running config stays", error);
+    message = fmt::format("reload refused: {}; the running config stays", error);
+  if (accepted || error == StageReloader::kSuperseded)
+    log::info("{}", message);
+  else
+    log::error("{}", message);
   if (newest) s->systemd.ready();
+  if (done) done(accepted, message);
   --s->running;  // last: the daemon may _exit from here on
 }
 

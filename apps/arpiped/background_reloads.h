@@ -4,7 +4,10 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "apps/arpiped/daemon.h"
 #include "apps/arpiped/systemd_notifier.h"
@@ -19,11 +22,17 @@ class BackgroundReloads {
   BackgroundReloads(const DaemonOptions& options, const Config& started, std::shared_ptr<StageReloader> reloader,
                     SystemdNotifier systemd);
 
+  // How a reload ended: applied (and what changed) or not (and why).
+  using Done = std::function<void(bool applied, const std::string& message)>;
+
   // Reloads the config file on a new thread (RELOADING=1 now, READY=1 once the newest reload is
   // answered). A change to a key that needs a restart refuses the whole reload, naming the key;
   // everything else is applied (stages, light source, sinks). Logs "reload applied: " and what
-  // changed, "reload refused: " and why, or that a newer SIGHUP superseded it.
-  void start();
+  // changed, "reload refused: " and why, or that a newer reload superseded it.
+  // why: what asked ("SIGHUP", "arpipe ctl set"). extra: assignments (as --set takes them) on top
+  // of the command line's and of those earlier applied ones; applied, they stay for every later
+  // reload until the daemon restarts. done: called on the reload's thread once it is answered.
+  void start(const std::string& why = "SIGHUP", std::vector<std::string> extra = {}, Done done = {});
   // Whether a reload thread is still running (stuck on a file, or baking): the daemon then leaves
   // with _exit rather than unwind what that thread may still touch.
   bool any_running() const;
@@ -31,7 +40,8 @@ class BackgroundReloads {
  private:
   struct Shared;  // what the (detached) reload threads share; outlives this object when one is stuck
   // One reload, on its own thread.
-  static void reload(const std::shared_ptr<Shared>& s, uint64_t ticket);
+  static void reload(const std::shared_ptr<Shared>& s, uint64_t ticket, const std::vector<std::string>& extra,
+                     const Done& done);
   std::shared_ptr<Shared> shared_;
 };
 

@@ -10,6 +10,8 @@
 #include <cstdio>
 
 #include "apps/arpiped/background_reloads.h"
+#include "apps/arpiped/control_server.h"
+#include "apps/arpiped/daemon_control.h"
 #include "apps/arpiped/stoppable_setup.h"
 #include "apps/arpiped/systemd_notifier.h"
 #include "apps/common/pipeline_assembly.h"
@@ -47,8 +49,22 @@ int run_daemon(const DaemonOptions& options) {
   if (!started) return 2;
   PipelineRunner& runner = *started->runner;
   log::info("running {} with {}", options.config_path.string(), runner.source_description());
-  systemd.ready();
   BackgroundReloads reloads(options, started->config, runner.reloader(), systemd);
+  DaemonControl control(runner, reloads, started->latest);
+  std::unique_ptr<ControlServer> control_server;
+  if (const auto path = control_socket_path(started->config.control.socket)) {
+    try {
+      control_server = std::make_unique<ControlServer>(*path, [&control](const ControlRequest& r) { return control.handle(r); });
+    } catch (const std::exception& e) {
+      // Asked for by name: a setup error. Systemd's runtime directory: the daemon runs without one.
+      if (!started->config.control.socket.empty()) {
+        log::error("{}", e.what());
+        return 2;
+      }
+      log::warn("{}; running without a control socket", e.what());
+    }
+  }
+  systemd.ready();
   if (started->reload_requested) reloads.start();
 
   const int64_t watchdog_ns = systemd.watchdog_interval_ns();

@@ -44,6 +44,7 @@ std::vector<std::string> keys_needing_restart(const Config& running, const Confi
   if (keys.empty() && !(a == b)) keys.push_back("source");  // a key not listed above
   note(keys, "pipeline.queue_depth", running, next, [](const Config& c) { return c.pipeline.queue_depth; });
   note(keys, "render.egl_platform", running, next, [](const Config& c) { return c.render.egl_platform; });
+  note(keys, "control.socket", running, next, [](const Config& c) { return c.control.socket; });
   return keys;
 }
 
@@ -80,6 +81,7 @@ std::vector<std::string> changed_parts(const Config& running, const Config& next
   note(parts, "sinks.y4m", a, b, [](const Config& c) { return c.sinks.y4m; });
   note(parts, "sinks.recording", a, b, [](const Config& c) { return c.sinks.recording; });
   note(parts, "sinks.results", a, b, [](const Config& c) { return c.sinks.results; });
+  note(parts, "sinks.http", a, b, [](const Config& c) { return c.sinks.http; });
 
   note(parts, "pipeline.max_frames", a, b, [](const Config& c) { return c.pipeline.max_frames; });
   note(parts, "pipeline.log_level", a, b, [](const Config& c) { return c.pipeline.log_level; });

@@ -24,6 +24,7 @@ struct SetupState {
   std::atomic<bool> done{false};
   Config config;
   std::unique_ptr<PipelineRunner> runner;
+  std::shared_ptr<LatestFrame> latest = std::make_shared<LatestFrame>();
   std::string error;  // empty: started
 };
 
@@ -33,6 +34,11 @@ void set_up(const DaemonOptions& options, SetupState& state) {
     log::set_max_level(state.config.pipeline.log_level);
     state.step = "opening the source";
     auto runner = assemble_pipeline(state.config);
+    runner->make_sinks_at_start([latest = state.latest] {
+      std::vector<std::unique_ptr<FrameSink>> sinks;
+      sinks.push_back(std::make_unique<LatestFrameSink>(latest));
+      return sinks;
+    });
     state.step = "loading the assets, configuring the stages and opening the outputs";
     runner->start();
     state.runner = std::move(runner);
@@ -72,7 +78,7 @@ std::optional<StartedPipeline> set_up_stoppably(const DaemonOptions& options, co
     log::error("{}", state.error);
     return std::nullopt;
   }
-  return StartedPipeline{std::move(state.config), std::move(state.runner), reload_requested, stop_requested};
+  return StartedPipeline{std::move(state.config), std::move(state.runner), state.latest, reload_requested, stop_requested};
 }
 
 }  // namespace arpipe

@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "apps/arpiped/daemon.h"
+#include "capture/sinks/latest_frame_sink.h"
 #include "core/config/config.h"
 #include "core/pipeline/pipeline_runner.h"
 
@@ -19,6 +20,7 @@ constexpr int kStoppedExitStatus = 0;
 struct StartedPipeline {
   Config config;
   std::unique_ptr<PipelineRunner> runner;  // started
+  std::shared_ptr<LatestFrame> latest;     // the newest composited frame, for arpipe ctl snapshot
   bool reload_requested = false;           // a SIGHUP came during the setup
   bool stop_requested = false;             // SIGTERM/SIGINT came as the setup finished
 };

@@ -4,6 +4,7 @@
 
 #include "capture/live/live_source.h"
 #include "capture/replay_source.h"
+#include "capture/sinks/http/http_sink.h"
 #include "capture/sinks/png_sink.h"
 #include "capture/sinks/recording_sink.h"
 #include "capture/sinks/results_sink.h"
@@ -41,12 +42,18 @@ SinkSlot slot(std::string key, Part part) {
 
 }  // namespace
 
-std::vector<SinkSlot> sink_slots() {
+std::vector<SinkSlot> sink_slots(StatusProvider status) {
   std::vector<SinkSlot> slots;
   slots.push_back(slot<ResultsSink>("sinks.results", [](const Config& c) -> const auto& { return c.sinks.results; }));
   slots.push_back(slot<PngSink>("sinks.png", [](const Config& c) -> const auto& { return c.sinks.png; }));
   slots.push_back(slot<Y4mSink>("sinks.y4m", [](const Config& c) -> const auto& { return c.sinks.y4m; }));
   slots.push_back(slot<RecordingSink>("sinks.recording", [](const Config& c) -> const auto& { return c.sinks.recording; }));
+  // The live outputs read the running pipeline's status (counters, sinks, camera) for /state and /metrics.
+  slots.push_back(SinkSlot{"sinks.http", [](const Config& a, const Config& b) { return a.sinks.http == b.sinks.http; },
+                           [status](const Config& config) -> std::unique_ptr<FrameSink> {
+                             if (!config.sinks.http.enabled) return nullptr;
+                             return std::make_unique<HttpSink>(config.sinks.http, status);
+                           }});
   return slots;
 }
 
@@ -99,7 +106,7 @@ std::unique_ptr<PipelineRunner> assemble_pipeline(const Config& config) {
   // mesh) or is stopped before then leaves the previous run's outputs as they were.
   auto runner = std::make_unique<PipelineRunner>(std::move(source), make_stage_factory(),
                                                  std::vector<std::unique_ptr<FrameSink>>{}, config);
-  runner->use_sink_slots(sink_slots());
+  runner->use_sink_slots(sink_slots(runner->status_provider()));
   return runner;
 }
 

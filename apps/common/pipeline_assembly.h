@@ -11,9 +11,10 @@
 namespace arpipe {
 
 std::unique_ptr<FrameSource> make_source(const Config& config);
-// The sinks by config key (sinks.results, sinks.png, sinks.y4m, sinks.recording): each made when
-// its section is enabled, and made anew by a reload that changes its section.
-std::vector<SinkSlot> sink_slots();
+// The sinks by config key (sinks.results, sinks.png, sinks.y4m, sinks.recording, sinks.http): each
+// made when its section is enabled, and made anew by a reload that changes its section. The live
+// outputs read the running pipeline's status through `status`.
+std::vector<SinkSlot> sink_slots(StatusProvider status);
 // track, motion (while tracking and motion are enabled), light (for any light.source but "fixed"),
 // render, composite (in that order), created on the processing thread; the optional ones come and
 // go with the config, reloads included.

@@ -179,6 +179,11 @@ std::string LiveSource::describe(const LiveCounters& c) {
                      c.frames_missed_while_away);
 }
 
+bool LiveSource::connected() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->stream != nullptr;
+}
+
 std::string LiveSource::health() const {
   bool connected = false;
   {

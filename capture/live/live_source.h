@@ -47,6 +47,7 @@ class LiveSource : public FrameSource {
   SourceStatus next(Frame& frame) override;
   void interrupt() override;
   std::string health() const override;
+  bool connected() const override;
 
   const StreamFormat& format() const;  // as first negotiated
   LiveCounters counters() const;

@@ -548,11 +548,38 @@ void visit(V& v, ResultsSinkConfig& s) {
   v.key("path", s.path, "per-frame pose, tracking state and timings as JSON lines");
 }
 
+// The live HTTP outputs (capture/sinks/http): the preview page, MJPEG, snapshots, state, metrics.
+struct HttpSinkConfig {
+  bool enabled = false;  // on when the config has its table ([sinks.*] below)
+  // "HOST:PORT" (IPv4 or [IPv6]), a Unix socket path (starting with "/" or "./"), or "systemd":
+  // the socket systemd passes (socket activation, systemd/arpiped-http.socket).
+  std::string listen = "127.0.0.1:8080";
+  int jpeg_quality = 85;
+  int max_clients = 16;
+  int client_timeout_ms = 10'000;
+  int camera_away_ms = 2'000;
+
+  bool operator==(const HttpSinkConfig&) const = default;
+};
+
+// Its keys, one row each: the name in the file, the member (whose initializer is the default), the
+// rule the value must meet, and the help `arpipe config --defaults` prints (docs/ARCHITECTURE.md, "Adding a config key").
+template <class V>
+void visit(V& v, HttpSinkConfig& s) {
+  v.key("enabled", s.enabled, "serve the live preview, MJPEG, snapshots, state and metrics over HTTP");
+  v.key("listen", s.listen, "\"HOST:PORT\" (loopback by default), a Unix socket path (\"/...\"), or \"systemd\" (socket activation)");
+  v.key("jpeg_quality", s.jpeg_quality, IntRange{1, 100}, "MJPEG and snapshot quality (libjpeg-turbo)");
+  v.key("max_clients", s.max_clients, IntRange{1, 1024}, "connections at once; more are refused");
+  v.key("client_timeout_ms", s.client_timeout_ms, IntRange{100, 3'600'000}, "a client that sends or takes nothing for this long is dropped");
+  v.key("camera_away_ms", s.camera_away_ms, IntRange{100, 600'000}, "no frame for this long: the stream shows a placeholder that says so");
+}
+
 struct SinksConfig {
   PngSinkConfig png;
   Y4mSinkConfig y4m;
   RecordingSinkConfig recording;
   ResultsSinkConfig results;
+  HttpSinkConfig http;
 
   bool operator==(const SinksConfig&) const = default;
 };
@@ -567,6 +594,7 @@ void visit(V& v, SinksConfig& s) {
   v.switched_section("y4m", s.y4m, "composited frames as a Y4M video");
   v.switched_section("recording", s.recording, "composited frames as a recording");
   v.switched_section("results", s.results, "per-frame pose, tracking state and timings as JSON lines");
+  v.switched_section("http", s.http, "live outputs over HTTP: preview page, MJPEG, snapshots, state, Prometheus metrics");
 }
 
 struct PipelineConfig {
@@ -586,6 +614,22 @@ void visit(V& v, PipelineConfig& s) {
   v.key("log_level", s.log_level, kLogLevelNames, "what the daemon logs");
 }
 
+// The daemon's control socket (arpipe ctl: status, reload, set, snapshot, record).
+struct ControlConfig {
+  // "": $RUNTIME_DIRECTORY/control.sock when systemd gives the service a runtime directory
+  // (RuntimeDirectory=arpipe: /run/arpipe/control.sock), else none; "off": none; else its path.
+  std::string socket;
+
+  bool operator==(const ControlConfig&) const = default;
+};
+
+// Its keys, one row each: the name in the file, the member (whose initializer is the default), the
+// rule the value must meet, and the help `arpipe config --defaults` prints (docs/ARCHITECTURE.md, "Adding a config key").
+template <class V>
+void visit(V& v, ControlConfig& s) {
+  v.key("socket", s.socket, "Unix socket for arpipe ctl; \"\": $RUNTIME_DIRECTORY/control.sock under systemd, else none; \"off\": none");
+}
+
 struct Config {
   std::filesystem::path file;  // where it came from, for messages
   SourceConfig source;
@@ -595,6 +639,7 @@ struct Config {
   RenderConfig render;
   SinksConfig sinks;
   PipelineConfig pipeline;
+  ControlConfig control;
 
   bool operator==(const Config&) const = default;
 };
@@ -610,6 +655,7 @@ void visit(V& v, Config& s) {
   v.section("render", s.render, "the virtual layer");
   v.section("sinks", s.sinks, "where the composited frames and results go");
   v.section("pipeline", s.pipeline, "threads and limits");
+  v.section("control", s.control, "the daemon's control socket (arpipe ctl)");
 }
 
 // The config's file for messages, or "config" when it was not read from one.

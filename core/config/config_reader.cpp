@@ -10,6 +10,7 @@
 
 #include "core/config/config.h"
 #include "core/config/config_overrides.h"
+#include "core/config/listen_address.h"
 #include "core/config/text_file.h"
 #include "core/config/toml_section.h"
 #include "core/image/camera_response.h"
@@ -69,6 +70,11 @@ void check_cross_keys(const TomlSection& t, RenderConfig& s) {
   if (length == 0) t.fail_with("light_direction", "expected a non-zero direction");
   // A vector already of unit length is kept bit for bit, so printing and reading a config is exact.
   if (std::abs(length - 1.0) > 1e-12) s.light_direction = normalized(s.light_direction);
+}
+
+void check_cross_keys(const TomlSection& t, HttpSinkConfig& s) {
+  std::string why;
+  if (!parse_listen_address(s.listen, why)) t.fail("listen", why, toml_quoted(s.listen));
 }
 
 template <class Section>

@@ -2,12 +2,19 @@
 // common in-memory form of light probes (row 0 at the top, 3 floats per pixel).
 #pragma once
 
+#include <cstdint>
+
 #include <cstddef>
 #include <vector>
 
 #include "core/geometry/vec.h"
 
 namespace arpipe {
+
+// What an HDR file may hold at most, whatever its header claims (the readers refuse more): a side of
+// 32768 pixels and 2^28 pixels (3 GiB of floats).
+constexpr int kMaxHdrSide = 32768;
+constexpr int64_t kMaxHdrPixels = int64_t{1} << 28;
 
 struct HdrImage {
   int width = 0, height = 0;

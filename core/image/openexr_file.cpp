@@ -28,8 +28,6 @@
 namespace arpipe {
 namespace {
 
-constexpr int kMaxSide = 32768;
-constexpr int64_t kMaxPixels = int64_t{1} << 28;
 constexpr int kBand = 16;  // rows per readPixels call
 // Header attributes: a light probe's are a few dozen bytes each (a preview image the most); a type
 // OpenEXR does not know is kept as opaque bytes, which nothing here reads.
@@ -38,10 +36,10 @@ constexpr uint32_t kMaxUnknownAttributeBytes = uint32_t{1} << 16;  // 64 KiB
 
 void check_size(const Imath::Box2i& window, const std::string& name) {
   const int64_t width = int64_t{window.max.x} - window.min.x + 1, height = int64_t{window.max.y} - window.min.y + 1;
-  if (width < 1 || height < 1 || width > kMaxSide || height > kMaxSide || width * height > kMaxPixels)
+  if (width < 1 || height < 1 || width > kMaxHdrSide || height > kMaxHdrSide || width * height > kMaxHdrPixels)
     throw AssetError(fmt::format("{}: data window ({}, {}) - ({}, {}) is {} x {} pixels; expected sides of 1..{} and "
                                  "at most 2^28 pixels",
-                                 name, window.min.x, window.min.y, window.max.x, window.max.y, width, height, kMaxSide));
+                                 name, window.min.x, window.min.y, window.max.x, window.max.y, width, height, kMaxHdrSide));
 }
 
 // The library trusts the header: an attribute size, a channel list or a data window from a corrupt
@@ -383,9 +381,9 @@ HdrImage read_openexr(const std::filesystem::path& path) {
 
 void write_openexr(const std::filesystem::path& path, const HdrImage& image) {
   const std::string name = path.string();
-  if (image.width < 1 || image.height < 1 || image.width > kMaxSide || image.height > kMaxSide)
+  if (image.width < 1 || image.height < 1 || image.width > kMaxHdrSide || image.height > kMaxHdrSide)
     throw AssetError(fmt::format("{}: cannot write a {} x {} image (sides must be 1..{})", name, image.width,
-                                 image.height, kMaxSide));
+                                 image.height, kMaxHdrSide));
   check_hdr_texels(image, name);
   constexpr float kHalfMax = 65504.0f;
   std::vector<Imf::Rgba> pixels(static_cast<size_t>(image.width) * static_cast<size_t>(image.height));

@@ -21,11 +21,9 @@
 namespace arpipe {
 namespace {
 
-constexpr int kMaxSide = 32768;
-constexpr int64_t kMaxPixels = int64_t{1} << 28;
 // Flat scanlines of the largest image (4 bytes a pixel) plus a generous header: a longer file holds
 // bytes no valid image can use.
-constexpr uint64_t kMaxFileBytes = uint64_t(kMaxPixels) * 4 + (uint64_t{1} << 20);
+constexpr uint64_t kMaxFileBytes = uint64_t(kMaxHdrPixels) * 4 + (uint64_t{1} << 20);
 
 std::string_view trimmed(std::string_view text) {
   while (!text.empty() && (text.front() == ' ' || text.front() == '\t')) text.remove_prefix(1);
@@ -116,9 +114,9 @@ class HeaderParser {
       throw AssetError(fmt::format("{}: resolution line (header line {}): expected a size for {}, found \"{}\"", name_,
                                    line_, axis, printable(token)));
     const int size = std::stoi(std::string(token));
-    if (size < 1 || size > kMaxSide)
+    if (size < 1 || size > kMaxHdrSide)
       throw AssetError(fmt::format("{}: resolution line (header line {}): {} size {} is outside 1..{}", name_, line_,
-                                   axis, size, kMaxSide));
+                                   axis, size, kMaxHdrSide));
     return size;
   }
 
@@ -147,7 +145,7 @@ class HeaderParser {
     layout.left_first = x_sign[0] == '+';
     layout.height = parse_size(layout.y_major ? tokens[1] : tokens[3], "Y (height)");
     layout.width = parse_size(layout.y_major ? tokens[3] : tokens[1], "X (width)");
-    if (int64_t{layout.width} * layout.height > kMaxPixels)
+    if (int64_t{layout.width} * layout.height > kMaxHdrPixels)
       throw AssetError(fmt::format("{}: resolution line (header line {}): {} x {} pixels is more than the 2^28 allowed",
                                    name_, line_, layout.width, layout.height));
   }
@@ -344,9 +342,9 @@ HdrImage read_radiance_hdr(const std::filesystem::path& file) {
 
 void write_radiance_hdr(const std::filesystem::path& file, const HdrImage& image, bool run_length) {
   const std::string name = file.string();
-  if (image.width < 1 || image.height < 1 || image.width > kMaxSide || image.height > kMaxSide)
+  if (image.width < 1 || image.height < 1 || image.width > kMaxHdrSide || image.height > kMaxHdrSide)
     throw AssetError(fmt::format("{}: cannot write a {} x {} image (sides must be 1..{})", name, image.width,
-                                 image.height, kMaxSide));
+                                 image.height, kMaxHdrSide));
   check_hdr_texels(image, name);
 
   std::string out = fmt::format("#?RADIANCE\nSOFTWARE=arpipe\nFORMAT=32-bit_rle_rgbe\n\n-Y {} +X {}\n", image.height,

@@ -89,6 +89,12 @@ struct FrameContext {
   std::vector<StageTiming> timings;
   uint64_t input_index = 0;                     // position in the stream as the pipeline saw it
   uint64_t dropped_before = 0;                  // frames lost just before this one (sequence gap or queue drop)
+  int64_t arrived_ns = 0;                       // CLOCK_MONOTONIC when the source handed the frame over
+
+  // Where end-to-end latency counts from: the end of the exposure (the last row's) when the source's
+  // timestamps are on this clock and at most 10 s before arrival (a live camera); otherwise the
+  // arrival (a replay, whose recorded times are not now).
+  int64_t latency_origin_ns() const;
 
   void record_timing(std::string stage, double ms, std::string skipped = {}) {
     timings.push_back({std::move(stage), ms, std::move(skipped)});

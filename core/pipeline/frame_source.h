@@ -31,6 +31,8 @@ class FrameSource {
   // What a live source has lived through ("disconnects 1, reconnects 1, timeouts 2"), for the
   // daemon's status; empty when there is nothing to say. Thread-safe.
   virtual std::string health() const { return {}; }
+  // False while a live camera is away (unplugged, being reopened). Thread-safe.
+  virtual bool connected() const { return true; }
 };
 
 }  // namespace arpipe

@@ -5,17 +5,20 @@
 #include <map>
 #include <string>
 
+#include "core/pipeline/latency_histogram.h"
+
 namespace arpipe {
 
 struct StageStats {
   uint64_t runs = 0;
   double total_ms = 0;
   std::map<std::string, uint64_t> skips;  // skip reason -> count
+  LatencyHistogram seconds;  // each run's time, skips included
 };
 
 struct PipelineMetrics {
   uint64_t frames_in = 0;         // frames the source delivered
-  uint64_t frames_out = 0;        // frames every sink has consumed
+  uint64_t frames_out = 0;        // frames handed to the sinks (each sink's own count: PipelineStatus)
   uint64_t sequence_gaps = 0;     // frames the source's sequence numbers say were lost
   uint64_t queue_drops = 0;       // frames dropped because processing fell behind (live only)
   uint64_t source_retries = 0;
@@ -23,6 +26,8 @@ struct PipelineMetrics {
   uint64_t frames_predicted = 0;  // no detection, pose extrapolated (TrackState::Predicted)
   uint64_t frames_lost = 0;
   std::map<std::string, StageStats> stages;
+  // From the end of exposure (FrameContext::latency_origin_ns) to the frame's hand-over to the sinks.
+  LatencyHistogram latency_seconds;
   double wall_seconds = 0;
   double fps() const { return wall_seconds > 0 ? frames_out / wall_seconds : 0; }
 };

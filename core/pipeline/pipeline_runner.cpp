@@ -17,12 +17,20 @@ PipelineRunner::PipelineRunner(std::unique_ptr<FrameSource> source, StageFactory
                                std::vector<std::unique_ptr<FrameSink>> sinks, const Config& config)
     : source_(std::move(source)), stage_factory_(std::move(stages)), config_(config),
       max_frames_(config.pipeline.max_frames) {
-  for (auto& sink : sinks) sinks_.push_back({std::string(), std::move(sink)});
+  unkeyed_sinks_ = std::move(sinks);
 }
 
 PipelineRunner::~PipelineRunner() {
   stop();
   wait();
+  // The sinks go first, while the queues and the source they may still ask about (a live output's
+  // status() from its connection threads) exist.
+  std::vector<std::unique_ptr<SinkWorker>> sinks;
+  {
+    std::lock_guard lock(sinks_mutex_);
+    sinks.swap(sinks_);
+  }
+  sinks.clear();
 }
 
 void PipelineRunner::start() {
@@ -64,17 +72,22 @@ void PipelineRunner::start() {
     throw;
   }
   // The outputs are opened last, once nothing slow or refusable is left before the first frame.
-  if (sink_factory_ || !sink_slots_.empty()) {
-    try {
-      if (sink_factory_)
-        for (auto& sink : sink_factory_()) sinks_.push_back({std::string(), std::move(sink)});
-      for (const SinkSlot& slot : sink_slots_)
-        if (std::unique_ptr<FrameSink> sink = slot.make(config_)) sinks_.push_back({slot.key, std::move(sink)});
-    } catch (...) {
-      to_process_->close();  // the processing thread ends, destroying the stages on its own thread
-      processing_thread_.join();
-      throw;
-    }
+  std::vector<std::unique_ptr<SinkWorker>> workers;
+  try {
+    for (auto& sink : unkeyed_sinks_) workers.push_back(make_worker(std::string(), std::move(sink)));
+    unkeyed_sinks_.clear();
+    if (sink_factory_)
+      for (auto& sink : sink_factory_()) workers.push_back(make_worker(std::string(), std::move(sink)));
+    for (const SinkSlot& slot : sink_slots_)
+      if (std::unique_ptr<FrameSink> sink = slot.make(config_)) workers.push_back(make_worker(slot.key, std::move(sink)));
+  } catch (...) {
+    to_process_->close();  // the processing thread ends, destroying the stages on its own thread
+    processing_thread_.join();
+    throw;
+  }
+  {
+    std::lock_guard lock(sinks_mutex_);
+    sinks_ = std::move(workers);
   }
   sink_thread_ = std::thread([this] { sink_loop(); });
   capture_thread_ = std::thread([this] { capture_loop(); });
@@ -114,6 +127,7 @@ void PipelineRunner::capture_loop() {
     const uint64_t sequence = ctx.camera.meta.sequence;
     if (previous_sequence && sequence > *previous_sequence + 1) ctx.dropped_before = sequence - *previous_sequence - 1;
     previous_sequence = sequence;
+    ctx.arrived_ns = monotonic_now_ns();
     ctx.camera_model = source_->camera_model();
     ctx.input_index = index++;
     {
@@ -141,6 +155,7 @@ void PipelineRunner::finish_frame(FrameContext& ctx, size_t first_stage) {
       auto& stats = metrics_.stages[t.stage];
       ++stats.runs;
       stats.total_ms += t.ms;
+      stats.seconds.add(t.ms * 1e-3);
       if (!t.skipped.empty()) ++stats.skips[t.skipped];
     }
     if (ctx.pose.state == TrackState::Tracking) ++metrics_.frames_tracked;
@@ -186,10 +201,17 @@ void PipelineRunner::processing_loop() {
   running_assets_.clear();
 }
 
+std::unique_ptr<SinkWorker> PipelineRunner::make_worker(std::string key, std::unique_ptr<FrameSink> sink) const {
+  // Replay must lose nothing, so a full queue waits for its sink; a live camera must not fall
+  // behind, so a slow sink loses its oldest frame (and counts it), never the others'.
+  return std::make_unique<SinkWorker>(std::move(key), std::move(sink), size_t(config_.pipeline.queue_depth),
+                                      source_->is_live() ? OverflowPolicy::DropOldest : OverflowPolicy::Block);
+}
+
 void PipelineRunner::sink_loop() {
-  // On the sink thread, so it never races consume(): the stages are configured and every sink
-  // exists, so the outputs of an earlier run may now be replaced.
-  for (auto& running : sinks_) running.sink->run_started();
+  // Each sink's thread tells it the run is up before its first frame: the stages are configured
+  // and every sink exists, so the outputs of an earlier run may now be replaced.
+  for (auto& worker : sinks_) worker->start();
   while (auto item = to_sink_->pop()) {
     sink_busy_since_ns_ = monotonic_now_ns();
     if (item->swap) {
@@ -197,37 +219,46 @@ void PipelineRunner::sink_loop() {
       sink_busy_since_ns_ = 0;
       continue;
     }
-    for (auto& running : sinks_) running.sink->consume(item->frame);
+    const int64_t origin_ns = item->frame.latency_origin_ns();
+    auto frame = std::make_shared<const FrameContext>(std::move(item->frame));
+    for (auto& worker : sinks_) worker->push(frame);
+    const int64_t now = monotonic_now_ns();
     sink_busy_since_ns_ = 0;
     std::lock_guard lock(metrics_mutex_);
     ++metrics_.frames_out;
-    metrics_.wall_seconds = double(monotonic_now_ns() - start_ns_) * 1e-9;
+    metrics_.latency_seconds.add(double(now - origin_ns) * 1e-9);
+    metrics_.wall_seconds = double(now - start_ns_) * 1e-9;
   }
-  for (auto& running : sinks_) running.sink->flush();
+  // Every sink takes what is queued for it and flushes.
+  for (auto& worker : sinks_) worker->finish();
   finished_ = true;
 }
 
 void PipelineRunner::swap_sinks(SinkSwap& swap) {
   for (auto& [key, next] : swap.sinks) {
-    auto running = std::find_if(sinks_.begin(), sinks_.end(), [&](const RunningSink& s) { return s.key == key; });
-    if (running != sinks_.end()) {
+    std::unique_ptr<SinkWorker> running;
+    {
+      std::lock_guard lock(sinks_mutex_);
+      auto found = std::find_if(sinks_.begin(), sinks_.end(), [&](const auto& w) { return w->key() == key; });
+      if (found != sinks_.end()) {
+        running = std::move(*found);
+        sinks_.erase(found);
+      }
+    }
+    if (running) {
       // Everything it was handed is written and durable, and its output closed, before a new
       // sink may take over the same path.
-      running->sink->flush();
-      const std::string closed = running->sink->describe();
-      running->sink.reset();
+      running->finish();
+      const std::string closed = running->describe();
+      running.reset();
       log::info("{}: closed {}", key, closed);
     }
     if (next) {
-      next->run_started();
-      log::info("{}: started {}", key, next->describe());
-    }
-    if (running == sinks_.end()) {
-      if (next) sinks_.push_back({key, std::move(next)});
-    } else if (next) {
-      running->sink = std::move(next);
-    } else {
-      sinks_.erase(running);
+      std::unique_ptr<SinkWorker> worker = make_worker(key, std::move(next));
+      worker->start();
+      log::info("{}: started {}", key, worker->describe());
+      std::lock_guard lock(sinks_mutex_);
+      sinks_.push_back(std::move(worker));
     }
   }
 }
@@ -281,10 +312,28 @@ PipelineMetrics PipelineRunner::metrics() const {
   return m;
 }
 
+PipelineStatus PipelineRunner::status() const {
+  PipelineStatus status;
+  status.metrics = metrics();
+  {
+    std::lock_guard lock(sinks_mutex_);
+    for (const auto& worker : sinks_) status.sinks.push_back(worker->stats());
+  }
+  status.source = source_->describe();
+  status.source_health = source_->health();
+  status.live = source_->is_live();
+  status.source_connected = source_->connected();
+  status.uptime_seconds = start_ns_ ? double(monotonic_now_ns() - start_ns_) * 1e-9 : 0;
+  return status;
+}
+
 bool PipelineRunner::healthy(int64_t max_stall_ns) const {
   const int64_t now = monotonic_now_ns();
-  for (const int64_t since : {busy_since_ns_.load(), sink_busy_since_ns_.load()})
-    if (since != 0 && now - since >= max_stall_ns) return false;
+  const auto stalled = [&](int64_t since) { return since != 0 && now - since >= max_stall_ns; };
+  if (stalled(busy_since_ns_) || stalled(sink_busy_since_ns_)) return false;
+  std::lock_guard lock(sinks_mutex_);
+  for (const auto& worker : sinks_)
+    if (stalled(worker->busy_since_ns())) return false;
   return true;
 }
 

@@ -16,6 +16,8 @@
 #include "core/pipeline/frame_sink.h"
 #include "core/pipeline/frame_source.h"
 #include "core/pipeline/pipeline_metrics.h"
+#include "core/pipeline/pipeline_status.h"
+#include "core/pipeline/sink_worker.h"
 #include "core/pipeline/sink_slot.h"
 #include "core/pipeline/stage.h"
 #include "core/pipeline/stage_reloader.h"
@@ -61,6 +63,11 @@ class PipelineRunner {
   static constexpr std::chrono::milliseconds kReconfigureBoundaryTimeout{10'000};
 
   PipelineMetrics metrics() const;
+  // The metrics, each sink's queue and the source's state; thread-safe, for the live outputs.
+  PipelineStatus status() const;
+  StatusProvider status_provider() const {
+    return [this] { return status(); };
+  }
   std::string source_description() const { return source_->describe(); }
   std::string source_health() const { return source_->health(); }
   // False when the processing or the sink thread has been inside one frame for longer than
@@ -78,15 +85,12 @@ class PipelineRunner {
   void sink_loop();
   // On the sink thread, between two frames: closes and starts the sinks a reload changed.
   void swap_sinks(SinkSwap& swap);
+  std::unique_ptr<SinkWorker> make_worker(std::string key, std::unique_ptr<FrameSink> sink) const;
 
   // What the sink thread takes, in order: a frame, or the sinks a reload changed.
   struct ToSink {
     FrameContext frame;
     std::shared_ptr<SinkSwap> swap;  // when set, no frame
-  };
-  struct RunningSink {
-    std::string key;  // its SinkSlot's; empty for the sinks no reload replaces
-    std::unique_ptr<FrameSink> sink;
   };
 
   std::unique_ptr<FrameSource> source_;
@@ -95,7 +99,11 @@ class PipelineRunner {
   std::vector<SinkSlot> sink_slots_;
   std::vector<std::unique_ptr<Stage>> stages_;
   std::vector<std::shared_ptr<const StageAssets>> running_assets_;  // what config_ was loaded into, per stage
-  std::vector<RunningSink> sinks_;  // the sink thread's once it runs
+  std::vector<std::unique_ptr<FrameSink>> unkeyed_sinks_;  // given to the constructor, until start()
+  // Each running sink on its own thread; the list is changed by the sink thread (reloads) under
+  // sinks_mutex_, which status() takes to read it.
+  std::vector<std::unique_ptr<SinkWorker>> sinks_;
+  mutable std::mutex sinks_mutex_;
   Config config_;
   std::atomic<int64_t> max_frames_{0};  // config_.pipeline.max_frames, for the capture thread
   std::unique_ptr<BoundedQueue<FrameContext>> to_process_;

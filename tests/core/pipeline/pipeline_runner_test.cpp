@@ -648,7 +648,8 @@ TEST(PipelineRunner, UnhealthyWhileAStageIsStuckHealthyWhenIdle) {
     release->changed.notify_all();
   }
   h.wait_until_sink_has(0, 1);
-  while (h.runner->metrics().frames_out < 1) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  // The sink's own thread has left consume() (frames_out counts frames handed to the sinks).
+  while (h.runner->status().sinks[0].consumed < 1) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   // Both threads now wait for a frame the source does not have: idle is healthy, even with a
   // threshold of 1 ns.
   EXPECT_TRUE(h.runner->healthy(1));
@@ -659,6 +660,52 @@ TEST(PipelineRunner, UnhealthyWhileAStageIsStuckHealthyWhenIdle) {
 }
 
 // A sink stuck on a hung disk must stop the watchdog too, not only a stuck stage.
+// Each sink has its own queue: with a live camera a slow sink loses its own oldest frames (counted
+// per sink) while a fast one takes every frame; nothing waits for the slow one.
+TEST(PipelineRunner, LiveCameraASlowSinkDropsItsOwnFramesAndNeverTheOthers) {
+  constexpr uint64_t kFrames = 150;
+  // The camera delivers a frame every millisecond: slower than the stages, far faster than the
+  // slow sink's 20 ms.
+  Harness h(Setup::replaying(frames_0_to(kFrames), AfterScript::BlockUntilInterrupted)
+                .as_live_camera()
+                .pausing_source_with([](int) { std::this_thread::sleep_for(std::chrono::milliseconds(1)); })
+                .with_sink_delays({std::chrono::microseconds(0), std::chrono::microseconds(20'000)}));
+  h.runner->start();
+  h.wait_until_sink_has(0, kFrames);
+  EXPECT_EQ(h.runner->metrics().queue_drops, 0u);
+  {
+    std::lock_guard lock(h.sink_logs[0]->mutex);
+    EXPECT_EQ(h.sink_logs[0]->sequences, iota(kFrames));
+  }
+  h.runner->stop();
+  h.runner->wait();
+  const PipelineStatus status = h.runner->status();
+  ASSERT_EQ(status.sinks.size(), 2u);
+  EXPECT_EQ(status.sinks[0].dropped, 0u);
+  EXPECT_EQ(status.sinks[0].consumed, kFrames);
+  // The slow sink: fewer frames, the rest dropped and counted, in order, none twice.
+  EXPECT_GT(status.sinks[1].dropped, 0u);
+  EXPECT_EQ(status.sinks[1].consumed + status.sinks[1].dropped, kFrames);
+  std::lock_guard lock(h.sink_logs[1]->mutex);
+  EXPECT_EQ(h.sink_logs[1]->sequences.size(), status.sinks[1].consumed);
+  EXPECT_TRUE(std::is_sorted(h.sink_logs[1]->sequences.begin(), h.sink_logs[1]->sequences.end()));
+  EXPECT_EQ(h.sink_logs[1]->sequences.back(), kFrames - 1);  // the newest frame is never the one dropped
+  EXPECT_EQ(h.sink_logs[1]->flushes, 1);
+}
+
+// A replay loses nothing: a slow sink makes the pipeline wait, and every sink gets every frame.
+TEST(PipelineRunner, ReplayASlowSinkGetsEveryFrame) {
+  Harness h(Setup::replaying(frames_0_to(40)).with_sink_delays({std::chrono::microseconds(0), std::chrono::microseconds(3'000)}));
+  h.runner->start();
+  h.runner->wait();
+  for (size_t sink = 0; sink < 2; ++sink) {
+    std::lock_guard lock(h.sink_logs[sink]->mutex);
+    EXPECT_EQ(h.sink_logs[sink]->sequences, iota(40)) << "sink " << sink;
+  }
+  for (const SinkStats& stats : h.runner->status().sinks) EXPECT_EQ(stats.dropped, 0u);
+  EXPECT_EQ(h.runner->metrics().latency_seconds.count(), 40u);
+}
+
 TEST(PipelineRunner, UnhealthyWhileASinkIsStuck) {
   Harness h(Setup::replaying(frames_0_to(1), AfterScript::BlockUntilInterrupted)
                 .with_sink_delays({std::chrono::microseconds(1'000'000)}));
@@ -673,7 +720,8 @@ TEST(PipelineRunner, UnhealthyWhileASinkIsStuck) {
   }
   EXPECT_TRUE(seen_unhealthy);
   h.wait_until_sink_has(0, 1);
-  while (h.runner->metrics().frames_out < 1) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  // The sink's own thread has left consume() (frames_out counts frames handed to the sinks).
+  while (h.runner->status().sinks[0].consumed < 1) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   EXPECT_TRUE(h.runner->healthy(1));
   h.runner->stop();
   h.runner->wait();

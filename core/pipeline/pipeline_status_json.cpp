@@ -1,0 +1,45 @@
+#include "core/pipeline/pipeline_status_json.h"
+
+#include <nlohmann/json.hpp>
+
+namespace arpipe {
+
+std::string pipeline_status_json(const PipelineStatus& status) {
+  using nlohmann::json;
+  json j;
+  j["camera"] = {{"source", status.source},
+                 {"live", status.live},
+                 {"connected", status.source_connected},
+                 {"health", status.source_health}};
+  const PipelineMetrics& m = status.metrics;
+  json stages = json::object();
+  for (const auto& [name, stats] : m.stages) {
+    json skips = json::object();
+    for (const auto& [reason, count] : stats.skips) skips[reason] = count;
+    stages[name] = {{"runs", stats.runs},
+                    {"mean_ms", stats.runs ? stats.total_ms / double(stats.runs) : 0.0},
+                    {"skips", skips}};
+  }
+  j["pipeline"] = {{"frames_in", m.frames_in},
+                   {"frames_out", m.frames_out},
+                   {"fps", m.fps()},
+                   {"uptime_s", status.uptime_seconds},
+                   {"queue_drops", m.queue_drops},
+                   {"sequence_gaps", m.sequence_gaps},
+                   {"source_retries", m.source_retries},
+                   {"frames_tracked", m.frames_tracked},
+                   {"frames_predicted", m.frames_predicted},
+                   {"frames_lost", m.frames_lost},
+                   {"latency_ms_mean", m.latency_seconds.count()
+                                           ? json(m.latency_seconds.sum() / double(m.latency_seconds.count()) * 1e3)
+                                           : json(nullptr)},
+                   {"stages", stages}};
+  json sinks = json::array();
+  for (const SinkStats& s : status.sinks)
+    sinks.push_back({{"key", s.key}, {"consumed", s.consumed}, {"dropped", s.dropped}, {"queued", s.queued}});
+  j["sinks"] = sinks;
+  // A source's description may hold any bytes a config or device gave it: replace what is not UTF-8.
+  return j.dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
+}  // namespace arpipe
