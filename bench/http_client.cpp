@@ -85,21 +85,25 @@ std::string lower(std::string s) {
 
 }  // namespace
 
+bool HttpConnection::read_headers(std::map<std::string, std::string>& headers) {
+  for (;;) {
+    std::optional<std::string> line = read_line();
+    if (!line) return false;
+    if (line->empty()) return true;
+    const size_t colon = line->find(':');
+    if (colon == std::string::npos) continue;
+    std::string value = line->substr(colon + 1);
+    value.erase(0, value.find_first_not_of(' '));
+    headers[lower(line->substr(0, colon))] = value;
+  }
+}
+
 std::optional<HttpResponse> HttpConnection::read_head() {
   std::optional<std::string> status = read_line();
   if (!status || !status->starts_with("HTTP/1.")) return std::nullopt;
   HttpResponse response;
   response.status = std::atoi(status->substr(9, 3).c_str());
-  for (;;) {
-    std::optional<std::string> line = read_line();
-    if (!line) return std::nullopt;
-    if (line->empty()) break;
-    const size_t colon = line->find(':');
-    if (colon == std::string::npos) continue;
-    std::string value = line->substr(colon + 1);
-    value.erase(0, value.find_first_not_of(' '));
-    response.headers[lower(line->substr(0, colon))] = value;
-  }
+  if (!read_headers(response.headers)) return std::nullopt;
   return response;
 }
 
@@ -141,16 +145,7 @@ std::optional<HttpResponse> HttpConnection::read_part() {
     if (line->starts_with("--")) break;
   }
   HttpResponse part;
-  for (;;) {
-    std::optional<std::string> line = read_line();
-    if (!line) return std::nullopt;
-    if (line->empty()) break;
-    const size_t colon = line->find(':');
-    if (colon == std::string::npos) continue;
-    std::string value = line->substr(colon + 1);
-    value.erase(0, value.find_first_not_of(' '));
-    part.headers[lower(line->substr(0, colon))] = value;
-  }
+  if (!read_headers(part.headers)) return std::nullopt;
   const auto length = part.headers.find("content-length");
   if (length == part.headers.end()) return std::nullopt;
   const size_t want = std::stoul(length->second);

@@ -38,6 +38,8 @@ class HttpConnection {
  private:
   bool fill();  // reads more into buffer_; false on close/timeout
   std::optional<std::string> read_line();
+  // Header lines up to the empty one, names lower-cased; false on a closed connection or timeout.
+  bool read_headers(std::map<std::string, std::string>& headers);
   int fd_ = -1;
   std::string buffer_;
 };

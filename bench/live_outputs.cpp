@@ -107,11 +107,12 @@ LiveRun run_live(const LatencyOptions& options, int clients, bool real_time, int
   runner->wait();
   done = true;
   watcher.join();
+  const PipelineMetrics metrics = runner->metrics();
+  runner.reset();  // the HTTP sink goes, and with it the streams: the readers end
   for (auto& reader : readers) {
     reader->thread.join();
     run.latency_ms.insert(run.latency_ms.end(), reader->latency_ms.begin(), reader->latency_ms.end());
   }
-  const PipelineMetrics metrics = runner->metrics();
   run.fps = metrics.fps();
   run.to_sinks_ms = metrics.latency_seconds.count() ? metrics.latency_seconds.sum() / double(metrics.latency_seconds.count()) * 1e3 : 0;
   return run;
@@ -160,7 +161,8 @@ int run_latency_benchmark(const LatencyOptions& options) {
              encode_alone_ms(200));
 
   const LiveRun real_time = run_live(options, 1, /*real_time=*/true, options.frames);
-  const double interval_ms = 1e3 / 30.0;
+  const std::optional<int64_t> interval_ns = make_source(probe)->frame_interval_ns();
+  const double interval_ms = interval_ns ? double(*interval_ns) * 1e-6 : 0;
   fmt::print("| real-time replay, 1 client | frames | p50 ms | p95 ms | p99 ms | to the sinks, mean ms | frame interval ms | encode ms |\n"
              "|---|---:|---:|---:|---:|---:|---:|---:|\n");
   fmt::print("| end of exposure (replay: arrival) to the client's last byte | {} | {:.1f} | {:.1f} | {:.1f} | {:.1f} | {:.1f} | {:.2f} |\n",

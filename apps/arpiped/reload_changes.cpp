@@ -45,6 +45,7 @@ std::vector<std::string> keys_needing_restart(const Config& running, const Confi
   note(keys, "pipeline.queue_depth", running, next, [](const Config& c) { return c.pipeline.queue_depth; });
   note(keys, "render.egl_platform", running, next, [](const Config& c) { return c.render.egl_platform; });
   note(keys, "control.socket", running, next, [](const Config& c) { return c.control.socket; });
+  note(keys, "pipeline.sink_queue_depth", running, next, [](const Config& c) { return c.pipeline.sink_queue_depth; });
   return keys;
 }
 

@@ -599,6 +599,7 @@ void visit(V& v, SinksConfig& s) {
 
 struct PipelineConfig {
   int queue_depth = 4;
+  int sink_queue_depth = 4;
   int64_t max_frames = 0;  // 0 = no limit
   log::Level log_level = log::Level::Info;
 
@@ -610,6 +611,8 @@ struct PipelineConfig {
 template <class V>
 void visit(V& v, PipelineConfig& s) {
   v.key("queue_depth", s.queue_depth, IntRange{1}, "frames between threads");
+  v.key("sink_queue_depth", s.sink_queue_depth, IntRange{1, 1024},
+        "frames waiting for each sink; beyond it a live camera's slow sink drops its oldest (a replay waits)");
   v.key("max_frames", s.max_frames, IntRange{0}, "stop after this many frames; 0 = no limit");
   v.key("log_level", s.log_level, kLogLevelNames, "what the daemon logs");
 }

@@ -204,7 +204,7 @@ void PipelineRunner::processing_loop() {
 std::unique_ptr<SinkWorker> PipelineRunner::make_worker(std::string key, std::unique_ptr<FrameSink> sink) const {
   // Replay must lose nothing, so a full queue waits for its sink; a live camera must not fall
   // behind, so a slow sink loses its oldest frame (and counts it), never the others'.
-  return std::make_unique<SinkWorker>(std::move(key), std::move(sink), size_t(config_.pipeline.queue_depth),
+  return std::make_unique<SinkWorker>(std::move(key), std::move(sink), size_t(config_.pipeline.sink_queue_depth),
                                       source_->is_live() ? OverflowPolicy::DropOldest : OverflowPolicy::Block);
 }
 

@@ -20,7 +20,9 @@ namespace arpipe {
 
 namespace {
 
-constexpr int kBacklog = 64;
+// Connections the kernel holds for the server to accept: a burst beyond it waits for TCP's 1 s
+// retry (accepting takes a thread start each).
+constexpr int kBacklog = 512;
 
 [[noreturn]] void fail(const ListenAddress& address, std::string_view what, int error) {
   throw std::runtime_error(fmt::format("listen = \"{}\": {}: {}", address.text(), what, std::strerror(error)));
