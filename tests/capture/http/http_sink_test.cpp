@@ -308,7 +308,15 @@ TEST(HttpSink, MalformedOversizedSlowAndRepeatedClientsLeaveItServing) {
   for (int i = 0; i < 50 && s.sink->counters().stream_clients > 0; ++i) std::this_thread::sleep_for(10ms);
   std::this_thread::sleep_for(200ms);
   const long after = rss_kib();
+#ifndef __SANITIZE_ADDRESS__
   EXPECT_LT(after - before, 8 * 1024) << "RSS grew from " << before << " KiB to " << after << " KiB";
+#else
+  // Under AddressSanitizer freed memory waits in its quarantine (up to 256 MB), so RSS measures
+  // the sanitizer, not the server: the cycles run here for what ASan finds, the bound holds in
+  // the plain build.
+  (void)before;
+  (void)after;
+#endif
   auto r = http_request(s.address, "/state");
   ASSERT_TRUE(r);
   EXPECT_EQ(r->status, 200);
