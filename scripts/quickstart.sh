@@ -9,7 +9,8 @@ scripts/install-deps.sh
 now() { date +%s.%N; }
 since() { awk -v a="$1" -v b="$2" 'BEGIN { printf "%.0f", b - a }'; }
 start=$(now)
-ARPIPE_BUILD_TARGETS="arpiped arpipe default_capture" scripts/build.sh build
+# Without the benchmarks (arpipe bench): the test command builds them into the same build/.
+ARPIPE_BUILD_TARGETS="arpiped arpipe default_capture" scripts/build.sh build -DARPIPE_BUILD_BENCH=OFF
 built=$(now)
 rm -rf out
 # The first composited frame is the first PNG the daemon writes (written whole, then renamed).
