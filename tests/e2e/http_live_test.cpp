@@ -109,17 +109,18 @@ std::string chromium() {
   return {};
 }
 
-// Runs headless Chromium on the page and returns its screenshot (3 s of loading, then the shot:
-// the page never finishes loading, its stream goes on).
+// Runs headless Chromium on the page and returns its screenshot. The page never finishes loading
+// (its stream goes on): the virtual time budget lets its script poll /state before the shot (or
+// the DOM dump), and the timeout ends it in any case.
 cv::Mat screenshot(const std::string& browser, const std::string& url, const fs::path& png) {
-  const std::string command = browser + " --no-sandbox --disable-gpu --hide-scrollbars --window-size=1100,600 --timeout=3000 --screenshot=" +
+  const std::string command = browser + " --no-sandbox --disable-gpu --hide-scrollbars --window-size=1100,600 --timeout=5000 --virtual-time-budget=2000 --screenshot=" +
                               png.string() + " " + url + " > " + png.string() + ".log 2>&1";
   EXPECT_EQ(std::system(command.c_str()), 0) << test::read_text(png.string() + ".log");
   return cv::imread(png.string(), cv::IMREAD_COLOR);
 }
 
 std::string dom(const std::string& browser, const std::string& url, const fs::path& out) {
-  const std::string command = browser + " --no-sandbox --disable-gpu --timeout=3000 --dump-dom " + url + " > " +
+  const std::string command = browser + " --no-sandbox --disable-gpu --timeout=5000 --virtual-time-budget=2000 --dump-dom " + url + " > " +
                               out.string() + " 2> " + out.string() + ".log";
   EXPECT_EQ(std::system(command.c_str()), 0) << test::read_text(out.string() + ".log");
   return test::read_text(out);
@@ -151,13 +152,21 @@ TEST_F(HttpLive, TheBrowserShowsALiveFrameAndItsState) {
 
   // The state panel, as the page's script filled it in: "<td id="sequence">S (index I)</td>".
   const auto frame_index = [](const std::string& html) -> long long {
-    const size_t cell = html.find("<td id=\"sequence\">");
-    const size_t index = cell == std::string::npos ? cell : html.find("(index ", cell);
-    return index == std::string::npos ? -1 : std::atoll(html.c_str() + index + 7);
+    const std::string open = "<td id=\"sequence\">";
+    const size_t cell = html.find(open);
+    if (cell == std::string::npos) return -1;
+    const std::string text = html.substr(cell + open.size(), html.find("</td>", cell) - cell - open.size());
+    const size_t index = text.find("(index ");
+    return index == std::string::npos ? -1 : std::atoll(text.c_str() + index + 7);
   };
   const std::string dom_a = dom(browser, url, dir_ / "a.html");
   ASSERT_GE(frame_index(dom_a), 0) << dom_a;
-  EXPECT_NE(dom_a.find("<td id=\"track_state\" class=\"tracking\">tracking</td>"), std::string::npos) << dom_a;
+  // The tracker's state, named and coloured (the capture's last frames look away from the tag, so
+  // any of the three may be showing).
+  const bool state_shown = dom_a.find("<td id=\"track_state\" class=\"tracking\">tracking</td>") != std::string::npos ||
+                           dom_a.find("<td id=\"track_state\" class=\"predicted\">predicted</td>") != std::string::npos ||
+                           dom_a.find("<td id=\"track_state\" class=\"lost\">lost</td>") != std::string::npos;
+  EXPECT_TRUE(state_shown) << dom_a;
   const std::string dom_b = dom(browser, url, dir_ / "b.html");
   ASSERT_GE(frame_index(dom_b), 0) << dom_b;
   EXPECT_GT(frame_index(dom_b), frame_index(dom_a));
