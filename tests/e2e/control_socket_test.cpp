@@ -112,9 +112,15 @@ TEST_F(ControlSocket, StatusSnapshotAndSet) {
 TEST_F(ControlSocket, RecordStartAndStopLeaveAReplayableRecording) {
   const fs::path recording = dir_ / "recorded";
   std::string out, err;
+  const auto frames_out = [&] {
+    std::string status;
+    return ctl({"status"}, &status) == 0 ? nlohmann::json::parse(status)["pipeline"]["frames_out"].get<uint64_t>() : 0;
+  };
   ASSERT_EQ(ctl({"record", "start", recording.string()}, &out, &err), 0) << err;
   EXPECT_NE(out.find("sinks.recording"), std::string::npos) << out;
-  std::this_thread::sleep_for(1500ms);  // about 45 frames at 30 frames/s
+  // At least 15 frames go by (half a second at 30 frames/s; longer under the sanitizers).
+  const uint64_t started = frames_out();
+  for (int i = 0; i < 300 && frames_out() < started + 15; ++i) std::this_thread::sleep_for(100ms);
   ASSERT_EQ(ctl({"record", "stop"}, &out, &err), 0) << err;
   const RecordingReader reader(recording);
   EXPECT_GT(reader.frame_count(), 10u);

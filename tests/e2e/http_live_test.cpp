@@ -69,8 +69,11 @@ TEST_F(HttpLive, StateStreamAndMetricsFollowTheReplay) {
     std::this_thread::sleep_for(100ms);
   }
   ASSERT_FALSE(first["frame"].is_null()) << daemon_->stderr_text();
-  std::this_thread::sleep_for(500ms);
-  const nlohmann::json later = state(address);
+  nlohmann::json later = state(address);
+  for (int i = 0; i < 100 && later["pipeline"]["frames_out"] == first["pipeline"]["frames_out"]; ++i) {
+    std::this_thread::sleep_for(100ms);
+    later = state(address);
+  }
   EXPECT_GT(later["pipeline"]["frames_out"].get<uint64_t>(), first["pipeline"]["frames_out"].get<uint64_t>());
   EXPECT_TRUE(later["frame"].contains("track_state"));
   EXPECT_FALSE(later["camera"]["away"].get<bool>());
