@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <chrono>
 #include <cstdlib>
 
 #include "core/log.h"
@@ -92,9 +93,16 @@ void ControlServer::answer(int client) {
   set_timeout(client, SO_SNDTIMEO, kSendTimeoutS);
   std::string line;
   char chunk[4096];
+  // A client that trickles its line (a byte every second) would hold the socket: the whole line
+  // must come within the receive limit, not each piece.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(kReceiveTimeoutS);
   while (line.find('\n') == std::string::npos) {
     if (line.size() > kMaxControlRequestBytes) {
       send_all(client, error_json("the request is longer than 64 KiB") + "\n");
+      return;
+    }
+    if (std::chrono::steady_clock::now() > deadline) {
+      send_all(client, error_json("the request line took longer than 2 s") + "\n");
       return;
     }
     const ssize_t n = ::recv(client, chunk, sizeof chunk, 0);

@@ -366,6 +366,27 @@ TEST(HttpSink, ServesOnAUnixSocket) {
   EXPECT_FALSE(std::filesystem::exists(path));  // removed when the sink goes
 }
 
+// A reload that changes [sinks.http] makes the new sink while the old one still serves (then
+// closes the old): the new one takes over the same socket, so the bind is not refused and the
+// address answers throughout.
+TEST(HttpSink, ANewSinkOnTheSameAddressTakesTheSocketOver) {
+  const std::filesystem::path path =
+      std::filesystem::temp_directory_path() / ("arpipe-http-reload-" + std::to_string(::getpid()) + ".sock");
+  HttpSinkConfig config;
+  config.listen = path.string();
+  auto old_sink = std::make_unique<Served>(config);
+  old_sink->sink->consume_shared(smooth_frame(0));
+  config.jpeg_quality = 50;  // a change of the section: a new sink
+  Served new_sink(config);
+  new_sink.sink->consume_shared(smooth_frame(1));
+  old_sink.reset();
+  EXPECT_EQ(std::filesystem::status(path).type(), std::filesystem::file_type::socket);
+  auto snapshot = http_request(path.string(), "/snapshot.png");
+  ASSERT_TRUE(snapshot);
+  EXPECT_EQ(snapshot->status, 200);
+  EXPECT_EQ(snapshot->headers["x-arpipe-sequence"], "501");  // the new sink's frame
+}
+
 // promtool (Debian's prometheus package) is the reference for the text format; skipped without it.
 TEST(HttpSink, PromtoolAcceptsTheMetrics) {
   Served s;
