@@ -200,8 +200,8 @@ TEST_F(ArpipeCli, VersionAndHelpOfEveryCommand) {
   ASSERT_EQ(run({"--version"}, &out, &err), 0) << err;
   EXPECT_EQ(out.rfind("arpipe 0.", 0), 0u) << out;  // the CMake project version, then git describe
   ASSERT_EQ(run({"--help"}, &out, &err), 0) << err;
-  const std::vector<std::string> commands{"inspect", "replay", "simulate", "calib", "board", "bench",
-                                          "sh",      "bake",   "sun",      "cameras", "record", "config"};
+  const std::vector<std::string> commands{"inspect", "replay", "simulate", "calib",  "board",  "bench", "sh",
+                                          "bake",    "sun",    "cameras",  "record", "config", "ctl"};
   for (const std::string& command : commands) {
     EXPECT_NE(out.find("  " + command + " "), std::string::npos) << command << "\n" << out;
     std::string help;
@@ -209,8 +209,8 @@ TEST_F(ArpipeCli, VersionAndHelpOfEveryCommand) {
     EXPECT_NE(help.find("Usage: arpipe " + command), std::string::npos) << help;
   }
   if (!benchmarks_built()) return;
-  for (const char* bench : {"pipeline", "scaling", "pose", "sim-render", "blur", "shadows", "probe", "sun", "capture-path",
-                            "calib-corners", "calib-solve", "sh", "prt"}) {
+  for (const char* bench : {"pipeline", "scaling", "latency", "pose", "sim-render", "blur", "shadows", "probe", "sun",
+                            "capture-path", "calib-corners", "calib-solve", "sh", "prt"}) {
     std::string help;
     EXPECT_EQ(run({"bench", bench, "--help"}, &help, &err), 0) << bench << ": " << err;
     EXPECT_NE(help.find(std::string("Usage: arpipe bench ") + bench), std::string::npos) << help;
