@@ -10,7 +10,6 @@
 
 #include <chrono>
 #include <ctime>
-#include <fstream>
 #include <memory>
 #include <string>
 #include <thread>
@@ -20,17 +19,11 @@
 #include "apps/common/pipeline_assembly.h"
 #include "bench/benchmarks.h"
 #include "bench/pipeline_run.h"
+#include "core/frame_memory.h"
 #include "core/log.h"
 
 namespace arpipe {
 namespace {
-
-long resident_kib() {
-  std::ifstream status("/proc/self/status");
-  for (std::string line; std::getline(status, line);)
-    if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
-  return -1;
-}
 
 struct PipelineOptions {
   std::string config = "configs/arpipe.toml";
@@ -115,7 +108,7 @@ int run_pipeline_benchmark(const PipelineOptions& options) {
     const int step = std::max(1, options.soak_seconds / 10);
     for (int t = 0; t <= options.soak_seconds; ++t) {
       std::this_thread::sleep_until(start + std::chrono::seconds(t));
-      last = resident_kib();
+      last = resident_memory_kib();
       peak = std::max(peak, last);
       if (t == std::min(10, options.soak_seconds)) first = last;  // after warm-up
       if (t % step == 0) fmt::print("| {} | {} | {:.1f} |\n", t, runner.metrics().frames_out, last / 1024.0);

@@ -2,6 +2,9 @@
 
 #include <malloc.h>
 
+#include <fstream>
+#include <string>
+
 namespace arpipe {
 
 void keep_frame_memory_resident() {
@@ -9,6 +12,13 @@ void keep_frame_memory_resident() {
   // 256 MiB of free space instead of trimming it back to the kernel after every frame.
   mallopt(M_MMAP_THRESHOLD, 64 << 20);
   mallopt(M_TRIM_THRESHOLD, 256 << 20);
+}
+
+long resident_memory_kib() {
+  std::ifstream status("/proc/self/status");
+  for (std::string line; std::getline(status, line);)
+    if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
+  return -1;
 }
 
 }  // namespace arpipe

@@ -8,4 +8,8 @@ namespace arpipe {
 // faults and 2 ms per 640x480 RGB24 frame without it, none with it.
 void keep_frame_memory_resident();
 
+// This process's resident set size (VmRSS) in KiB, -1 when /proc does not say: for soak
+// benchmarks and the tests that memory stays flat.
+long resident_memory_kib();
+
 }  // namespace arpipe

@@ -5,10 +5,8 @@
 #include <chrono>
 #include <future>
 
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
-
 #include "capture/sinks/http/jpeg_encoder.h"
+#include "capture/sinks/png_encoding.h"
 #include "core/config/toml_text.h"
 #include "core/pipeline/pipeline_status_json.h"
 
@@ -26,7 +24,7 @@ std::string dump(const nlohmann::json& j) { return j.dump(-1, ' ', false, nlohma
 ControlReply DaemonControl::handle(const ControlRequest& request) {
   switch (request.kind) {
     case ControlRequest::Kind::Status: {
-      nlohmann::json j = {{"ok", true}, {"status", nlohmann::json::parse(pipeline_status_json(runner_.status()))}};
+      nlohmann::json j = {{"ok", true}, {"status", pipeline_status_json(runner_.status())}};
       return {dump(j), {}};
     }
     case ControlRequest::Kind::Reload: return reload("arpipe ctl reload", {});
@@ -60,10 +58,7 @@ ControlReply DaemonControl::snapshot(const std::string& format) {
     JpegEncoder encoder;
     bytes = encoder.encode(rgb, kSnapshotJpegQuality);
   } else {
-    cv::Mat image(rgb.height, rgb.width, CV_8UC3, const_cast<uint8_t*>(rgb.data.data()), rgb.bytes_per_line), bgr;
-    cv::cvtColor(image, bgr, cv::COLOR_RGB2BGR);
-    std::vector<uint8_t> png;
-    if (!cv::imencode(".png", bgr, png)) return {dump({{"ok", false}, {"error", "PNG encoding failed"}}), {}};
+    const std::vector<uint8_t> png = encode_png(rgb);
     bytes.assign(png.begin(), png.end());
   }
   nlohmann::json j = {{"ok", true},

@@ -30,14 +30,20 @@ std::unique_ptr<FrameSource> make_source(const Config& config) {
 
 namespace {
 
-// The slot of the sink S made from the part of the config that `part` picks.
+// The slot of the sink that `make` makes from the part of the config that `part` picks.
+template <typename Part, typename Make>
+SinkSlot slot(std::string key, Part part, Make make) {
+  return SinkSlot{std::move(key), [part](const Config& a, const Config& b) { return part(a) == part(b); },
+                  [part, make](const Config& config) -> std::unique_ptr<FrameSink> {
+                    if (!part(config).enabled) return nullptr;
+                    return make(part(config));
+                  }};
+}
+
+// The same for a sink S made from its part alone.
 template <typename S, typename Part>
 SinkSlot slot(std::string key, Part part) {
-  return SinkSlot{std::move(key), [part](const Config& a, const Config& b) { return part(a) == part(b); },
-                  [part](const Config& config) -> std::unique_ptr<FrameSink> {
-                    if (!part(config).enabled) return nullptr;
-                    return std::make_unique<S>(part(config));
-                  }};
+  return slot(std::move(key), part, [](const auto& section) { return std::make_unique<S>(section); });
 }
 
 }  // namespace
@@ -49,11 +55,8 @@ std::vector<SinkSlot> sink_slots(StatusProvider status) {
   slots.push_back(slot<Y4mSink>("sinks.y4m", [](const Config& c) -> const auto& { return c.sinks.y4m; }));
   slots.push_back(slot<RecordingSink>("sinks.recording", [](const Config& c) -> const auto& { return c.sinks.recording; }));
   // The live outputs read the running pipeline's status (counters, sinks, camera) for /state and /metrics.
-  slots.push_back(SinkSlot{"sinks.http", [](const Config& a, const Config& b) { return a.sinks.http == b.sinks.http; },
-                           [status](const Config& config) -> std::unique_ptr<FrameSink> {
-                             if (!config.sinks.http.enabled) return nullptr;
-                             return std::make_unique<HttpSink>(config.sinks.http, status);
-                           }});
+  slots.push_back(slot("sinks.http", [](const Config& c) -> const auto& { return c.sinks.http; },
+                       [status](const HttpSinkConfig& http) { return std::make_unique<HttpSink>(http, status); }));
   return slots;
 }
 

@@ -4,12 +4,11 @@
 
 #include <algorithm>
 #include <cstring>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 #include <stdexcept>
 #include <vector>
 
 #include "capture/sinks/output_path.h"
+#include "capture/sinks/png_encoding.h"
 
 namespace arpipe {
 
@@ -32,18 +31,9 @@ void PngSink::consume(const FrameContext& ctx) noexcept {
   std::string why;
   try {
     const auto path = file_name(dir_, ctx.input_index);
-    const cv::Mat rgb(ctx.output.height, ctx.output.width, CV_8UC3, const_cast<uint8_t*>(ctx.output.data.data()),
-                      ctx.output.bytes_per_line);
-    cv::Mat bgr;
-    cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
     // Encoded in memory: libpng never meets a failing file (and prints nothing), and the file is
     // written whole or not at all.
-    std::vector<uint8_t> png;
-    // Level 1 is OpenCV's default, which also picks its fast filter and strategy: naming the level
-    // would switch those, so the default stays unnamed and its PNGs keep their bytes.
-    std::vector<int> params;
-    if (compression_ != 1) params = {cv::IMWRITE_PNG_COMPRESSION, compression_};
-    if (!cv::imencode(".png", bgr, png, params)) throw std::runtime_error("the PNG encoder refused the frame");
+    const std::vector<uint8_t> png = encode_png(ctx.output, compression_);
     if (const int error = replace_file(path, png))
       why = fmt::format("{}: {}", path.string(), std::strerror(error));
   } catch (const std::exception& e) {

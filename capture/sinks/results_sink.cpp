@@ -28,7 +28,9 @@ void ResultsSink::run_started() noexcept {
 
 std::string ResultsSink::describe() const { return "results:" + path_.string(); }
 
-std::string ResultsSink::to_json_line(const FrameContext& ctx) {
+std::string ResultsSink::to_json_line(const FrameContext& ctx) { return to_json(ctx).dump(); }
+
+nlohmann::json ResultsSink::to_json(const FrameContext& ctx) {
   using nlohmann::json;
   json j;
   j["index"] = ctx.input_index;
@@ -96,7 +98,7 @@ std::string ResultsSink::to_json_line(const FrameContext& ctx) {
   }
   j["stage_ms"] = timings;
   j["skipped"] = skips;
-  return j.dump();
+  return j;
 }
 
 void ResultsSink::consume(const FrameContext& ctx) noexcept {

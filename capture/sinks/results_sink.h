@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <nlohmann/json_fwd.hpp>
 
 #include "capture/sinks/output_file.h"
 #include "capture/sinks/write_outage.h"
@@ -23,6 +24,8 @@ class ResultsSink : public FrameSink {
   void flush() noexcept override;
   uint64_t failures() const { return outage_.failures() + encode_failures_; }
 
+  // What the pipeline found for one frame, as a JSON object (the live outputs' /state embeds it).
+  static nlohmann::json to_json(const FrameContext& ctx);
   // The JSON line for one frame (without the newline).
   static std::string to_json_line(const FrameContext& ctx);
 

@@ -4,7 +4,7 @@
 
 namespace arpipe {
 
-std::string pipeline_status_json(const PipelineStatus& status) {
+nlohmann::json pipeline_status_json(const PipelineStatus& status) {
   using nlohmann::json;
   json j;
   j["camera"] = {{"source", status.source},
@@ -38,8 +38,7 @@ std::string pipeline_status_json(const PipelineStatus& status) {
   for (const SinkStats& s : status.sinks)
     sinks.push_back({{"key", s.key}, {"consumed", s.consumed}, {"dropped", s.dropped}, {"queued", s.queued}});
   j["sinks"] = sinks;
-  // A source's description may hold any bytes a config or device gave it: replace what is not UTF-8.
-  return j.dump(-1, ' ', false, json::error_handler_t::replace);
+  return j;
 }
 
 }  // namespace arpipe

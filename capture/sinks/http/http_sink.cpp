@@ -2,13 +2,11 @@
 
 #include <fmt/format.h>
 
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
-
 #include "capture/sinks/http/live_state.h"
 #include "capture/sinks/http/mjpeg_stream.h"
 #include "capture/sinks/http/placeholder_frame.h"
 #include "capture/sinks/http/preview_page.h"
+#include "capture/sinks/png_encoding.h"
 #include "core/log.h"
 #include "core/pipeline/monotonic_clock.h"
 
@@ -136,11 +134,7 @@ HttpReply HttpSink::snapshot(bool png) {
   reply.headers = {{"X-Arpipe-Sequence", fmt::format("{}", frame->camera.meta.sequence)},
                    {"X-Arpipe-Exposure-Start-Ns", fmt::format("{}", frame->camera.meta.exposure_start_ns)}};
   if (png) {
-    const Frame& rgb = frame->output;
-    cv::Mat image(rgb.height, rgb.width, CV_8UC3, const_cast<uint8_t*>(rgb.data.data()), rgb.bytes_per_line), bgr;
-    cv::cvtColor(image, bgr, cv::COLOR_RGB2BGR);
-    std::vector<uint8_t> bytes;
-    if (!cv::imencode(".png", bgr, bytes)) return text_reply(500, "PNG encoding failed\n");
+    const std::vector<uint8_t> bytes = encode_png(frame->output);
     reply.content_type = "image/png";
     reply.body.assign(bytes.begin(), bytes.end());
     return reply;

@@ -11,8 +11,8 @@ namespace arpipe {
 std::string live_state_json(const PipelineStatus& status, const FrameContext* latest, double frame_age_s,
                             bool camera_away, const HttpCounters& http) {
   using nlohmann::json;
-  json j = json::parse(pipeline_status_json(status));
-  j["frame"] = latest ? json::parse(ResultsSink::to_json_line(*latest)) : json(nullptr);
+  json j = pipeline_status_json(status);
+  j["frame"] = latest ? ResultsSink::to_json(*latest) : json(nullptr);
   j["frame_age_s"] = latest ? json(frame_age_s) : json(nullptr);
   if (latest && (latest->pose.state == TrackState::Tracking || latest->pose.state == TrackState::Predicted)) {
     const Vec3 c = latest->pose.T_cam_world.inverse().translation();

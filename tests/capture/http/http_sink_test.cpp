@@ -19,6 +19,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "capture/sinks/http/http_sink.h"
+#include "core/frame_memory.h"
 #include "core/pipeline/monotonic_clock.h"
 #include "bench/http_client.h"
 
@@ -290,15 +291,9 @@ TEST(HttpSink, MalformedOversizedSlowAndRepeatedClientsLeaveItServing) {
     EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 5.0);
   }
   // A thousand connect/disconnect cycles, some after half a request: memory stays flat.
-  const auto rss_kib = [] {
-    std::ifstream status("/proc/self/status");
-    std::string line;
-    while (std::getline(status, line))
-      if (line.starts_with("VmRSS:")) return std::stol(line.substr(6));
-    return 0L;
-  };
+
   for (int i = 0; i < 100; ++i) HttpConnection warmup(s.address);
-  const long before = rss_kib();
+  const long before = resident_memory_kib();
   for (int i = 0; i < 1000; ++i) {
     HttpConnection c(s.address, 2s);
     ASSERT_TRUE(c.connected()) << "cycle " << i;
@@ -307,7 +302,7 @@ TEST(HttpSink, MalformedOversizedSlowAndRepeatedClientsLeaveItServing) {
   // Give the connection threads a moment to end.
   for (int i = 0; i < 50 && s.sink->counters().stream_clients > 0; ++i) std::this_thread::sleep_for(10ms);
   std::this_thread::sleep_for(200ms);
-  const long after = rss_kib();
+  const long after = resident_memory_kib();
 #ifndef __SANITIZE_ADDRESS__
   EXPECT_LT(after - before, 8 * 1024) << "RSS grew from " << before << " KiB to " << after << " KiB";
 #else
