@@ -38,6 +38,11 @@ int64_t monotonic_ns() {
   return int64_t(ts.tv_sec) * 1000000000 + ts.tv_nsec;
 }
 
+bool blocking_file(const OpenFile& file) {
+  const int flags = ::fcntl(file.fd, F_GETFL);  // follows F_SETFL changes the host makes
+  return flags >= 0 && (flags & O_NONBLOCK) == 0;
+}
+
 Device::Device(DeviceConfig config)
     : config_(std::move(config)),
       source_(config_),
@@ -71,11 +76,6 @@ void Device::disconnect_all() {
   files_.clear();
   stop_streaming();
   free_buffers();
-}
-
-bool Device::blocking(const OpenFile& file) const {
-  const int flags = ::fcntl(file.fd, F_GETFL);  // follows F_SETFL changes the host makes
-  return flags >= 0 && (flags & O_NONBLOCK) == 0;
 }
 
 // ---- The schedule ------------------------------------------------------------------------------
@@ -483,7 +483,7 @@ int Device::qbuf(OpenFile& file, v4l2_buffer& b) {
 int Device::dqbuf(OpenFile& file, v4l2_buffer& b, const Waiter& wait) {
   if (b.type != kCapture || b.memory != V4L2_MEMORY_MMAP) return EINVAL;
   if (busy(file)) return EBUSY;
-  const bool may_block = blocking(file);
+  const bool may_block = blocking_file(file);
   for (;;) {
     if (file.dead) return EIO;  // vb2 after a disconnect while waiting: the queue is in error state
     if (!streaming_) return EINVAL;
@@ -602,7 +602,7 @@ int Device::subscribe(OpenFile& file, const v4l2_event_subscription& s) {
 }
 
 int Device::dqevent(OpenFile& file, v4l2_event& e, const Waiter& wait) {
-  const bool may_block = blocking(file);
+  const bool may_block = blocking_file(file);
   for (;;) {
     if (file.dead) return ENODEV;
     if (file.events.dequeue(e)) return 0;

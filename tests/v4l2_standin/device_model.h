@@ -6,37 +6,18 @@
 
 #include <cstdint>
 #include <deque>
-#include <functional>
 #include <memory>
 #include <vector>
 
 #include "control_table.h"
-#include "event_queue.h"
 #include "fault_plan.h"
 #include "frame_source.h"
+#include "served_node.h"
 #include "standin_config.h"
-#include "v4l2_standin.h"
 
 namespace arpipe::standin {
 
-inline constexpr int64_t kNever = INT64_MAX;
-
-int64_t monotonic_ns();
-
-class Device;
-
-// An open file description of a served device (one per tracked fd).
-struct OpenFile {
-  int fd = -1;
-  std::shared_ptr<Device> device;
-  bool dead = false;  // the device was unplugged or unloaded: ENODEV from now on
-  EventQueue events;
-};
-
-// Waits (with the registry's lock released) until the deadline (kNever: until woken).
-using Waiter = std::function<void(int64_t deadline_ns)>;
-
-class Device {
+class Device final : public Node {
  public:
   // Opens the recording; throws StandinConfigError.
   explicit Device(DeviceConfig config);
@@ -44,28 +25,26 @@ class Device {
   Device(const Device&) = delete;
   Device& operator=(const Device&) = delete;
 
-  const std::string& path() const { return config_.path; }
+  const std::string& path() const override { return config_.path; }
   // Everything below runs with the registry's lock held.
   // False while unplugged (until the replug time has passed).
-  bool present(int64_t now);
-  void attach(OpenFile& file);
-  void detach(OpenFile& file);  // close(): the owner's close stops streaming and frees the buffers
-  bool open() const { return open_count_ > 0; }
+  bool present(int64_t now) override;
+  void attach(OpenFile& file) override;
+  void detach(OpenFile& file) override;
+  bool open() const override { return open_count_ > 0; }
   // Unload: every open file goes dead (ENODEV) and streaming stops.
-  void disconnect_all();
+  void disconnect_all() override;
 
   // Lets every frame that is due by `now` fall due (faults, controls, events, buffers).
-  void advance(int64_t now);
+  void advance(int64_t now) override;
   // When advance() may next have something to do; kNever: only when the host acts.
-  int64_t next_wake(int64_t now) const;
+  int64_t next_wake(int64_t now) const override;
 
   // A V4L2 ioctl: 0 or an errno.
-  int ioctl(OpenFile& file, unsigned long request, void* arg, const Waiter& wait);
-  short poll_events(const OpenFile& file, short requested) const;
+  int ioctl(OpenFile& file, unsigned long request, void* arg, const Waiter& wait) override;
+  short poll_events(const OpenFile& file, short requested) const override;
   // mmap of a buffer: the mapping, or MAP_FAILED with errno set.
-  void* mmap(void* addr, size_t length, int prot, int flags, int64_t offset);
-
-  struct ::arpipe_v4l2_standin_stats stats{};
+  void* mmap(void* addr, size_t length, int prot, int flags, int64_t offset) override;
 
  private:
   struct Buffer {
@@ -100,7 +79,6 @@ class Device {
   void deliver(uint64_t g, int64_t at);
   void unplug(int64_t at, int64_t replug_after_ns);
   void free_buffers();
-  bool blocking(const OpenFile& file) const;
 
   DeviceConfig config_;
   FrameSource source_;

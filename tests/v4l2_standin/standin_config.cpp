@@ -98,15 +98,80 @@ DeviceConfig read_device(const TomlSection& s, const std::filesystem::path& base
   return d;
 }
 
-std::vector<DeviceConfig> read_config(const TomlSection& file, const std::filesystem::path& base) {
+// An absolute device path under `key` (required).
+std::string read_device_path(const TomlSection& s, std::string_view key) {
+  require(s, key, "an absolute path");
+  const std::string path = s.string(key, "");
+  if (path.empty() || path[0] != '/') s.fail(key, "an absolute path", toml_quoted(path));
+  return normal_device_path(path);
+}
+
+LoopbackStall read_loopback_fault(const TomlSection& s) {
+  LoopbackStall f;
+  f.place = table_place(s);
+  const IntRange frames{0, INT32_MAX};
+  require(s, "frame", frames.phrase());
+  f.frame = uint64_t(s.integer("frame", 0, frames));
+  require(s, "kind", "\"stall\"");
+  if (s.string("kind", "") != "stall") s.fail("kind", "\"stall\"", toml_quoted(s.string("kind", "")));
+  const IntRange stall{1, kMaxMs};
+  require(s, "duration_ms", stall.phrase());
+  f.duration_ns = s.integer("duration_ms", 0, stall) * 1000000;
+  return f;
+}
+
+LoopbackConfig read_loopback(const TomlSection& s, const std::filesystem::path& base, size_t index) {
+  LoopbackConfig l;
+  l.place = table_place(s);
+  l.output = read_device_path(s, "output");
+  l.capture = read_device_path(s, "capture");
+  if (l.capture == l.output) s.fail("capture", "a path other than the output's", toml_quoted(l.capture));
+  require(s, "spool", "a directory");
+  const std::string spool = s.string("spool", "");
+  if (spool.empty()) s.fail("spool", "a directory", toml_quoted(spool));
+  l.spool = (base / spool).lexically_normal();
+  l.card = s.string("card", l.card);
+  l.bus_info = s.string("bus_info", fmt::format("platform:arpipe-loopback-{}", index));
+  l.formats = read_formats(s, l.formats);
+  for (const OfferedFormatName f : l.formats)
+    if (f == OfferedFormatName::Native || f == OfferedFormatName::Mjpg)
+      s.fail("formats", "an array of raw pixel formats, each one of \"YUYV\", \"RGB24\", \"GREY\", \"NV12\"",
+             toml_quoted(std::string(choice_name<OfferedFormatName>(kOfferedFormatNames, f))));
+  for (size_t i = 0; i < l.formats.size(); ++i)
+    for (size_t j = 0; j < i; ++j)
+      if (l.formats[i] == l.formats[j])
+        s.fail("formats", "each format once",
+               toml_quoted(std::string(choice_name<OfferedFormatName>(kOfferedFormatNames, l.formats[i]))) + " twice");
+  // 16384 keeps a frame (at most 3 bytes a pixel) under 1 GiB, so sizes fit V4L2's 32-bit fields.
+  l.max_width = s.integer_as<int>("max_width", l.max_width, IntRange{2, 16384});
+  l.max_height = s.integer_as<int>("max_height", l.max_height, IntRange{2, 16384});
+  l.max_spool_bytes = s.integer("max_spool_mib", l.max_spool_bytes >> 20, IntRange{1, int64_t(1) << 24}) << 20;
+  for (const TomlSection& fault : s.sections("fault", 10000)) l.stalls.push_back(read_loopback_fault(fault));
+  return l;
+}
+
+StandinConfig read_config(const TomlSection& file, const std::filesystem::path& base) {
   const std::vector<TomlSection> devices = file.sections("device");
-  if (devices.empty()) file.fail("device", "at least one [[device]] table", file.has("device") ? "none" : "nothing");
-  std::vector<DeviceConfig> out;
+  const std::vector<TomlSection> loopbacks = file.sections("loopback");
+  if (devices.empty() && loopbacks.empty())
+    file.fail("device", "at least one [[device]] or [[loopback]] table", file.has("device") ? "none" : "nothing");
+  StandinConfig out;
+  // Every served path once, whichever table serves it.
   std::set<std::string> paths;
   for (const TomlSection& device : devices) {
-    out.push_back(read_device(device, base, out.size()));
-    if (!paths.insert(out.back().path).second)
-      device.fail("path", "a path no earlier [[device]] serves", toml_quoted(out.back().path));
+    out.devices.push_back(read_device(device, base, out.devices.size()));
+    if (!paths.insert(out.devices.back().path).second)
+      device.fail("path", "a path no earlier [[device]] serves", toml_quoted(out.devices.back().path));
+  }
+  std::set<std::filesystem::path> spools;
+  for (const TomlSection& loopback : loopbacks) {
+    out.loopbacks.push_back(read_loopback(loopback, base, out.loopbacks.size()));
+    const LoopbackConfig& l = out.loopbacks.back();
+    for (const auto& [key, path] : {std::pair{"output", l.output}, std::pair{"capture", l.capture}})
+      if (!paths.insert(path).second)
+        loopback.fail(key, "a path no earlier [[device]] or [[loopback]] serves", toml_quoted(path));
+    if (!spools.insert(l.spool).second)
+      loopback.fail("spool", "a directory no earlier [[loopback]] uses", toml_quoted(l.spool.string()));
   }
   file.reject_stray_keys();
   return out;
@@ -125,7 +190,7 @@ std::string normal_device_path(const std::string& path) {
   return out;
 }
 
-std::vector<DeviceConfig> load_standin_config(const std::filesystem::path& file) {
+StandinConfig load_standin_config(const std::filesystem::path& file) {
   const std::string name = file.string();
   std::string why;
   const auto text = read_text_file(file, why);

@@ -50,9 +50,37 @@ struct DeviceConfig {
   std::string formats_place;  // ... of its formats key (the table's when absent)
 };
 
+// A loopback fault: the output node holds its buffers for a while, as a reader that stops reading
+// would on a device that waits for it (kind "stall", the only kind).
+struct LoopbackStall {
+  uint64_t frame = 0;        // 0-based count of frames the output node has taken since the load
+  int64_t duration_ns = 0;
+  std::string place;         // "file:line:column" of the [[loopback.fault]] table
+};
+
+// An output node paired with a capture node, as v4l2loopback pairs them: frames written to the
+// output pass through the spool directory (so across processes) and are read from the capture node.
+struct LoopbackConfig {
+  std::string output;                // absolute and lexically normal
+  std::string capture;               // likewise; not the output's path
+  std::filesystem::path spool;       // absolute
+  std::string card = "arpipe V4L2 loopback";
+  std::string bus_info;              // default "platform:arpipe-loopback-<index>"
+  std::vector<OfferedFormatName> formats = {OfferedFormatName::Yuyv, OfferedFormatName::Rgb24};  // raw ones only
+  int max_width = 8192, max_height = 8192;  // v4l2loopback's defaults
+  int64_t max_spool_bytes = int64_t(1) << 30;
+  std::vector<LoopbackStall> stalls;
+  std::string place;          // "file:line:column" of the [[loopback]] table
+};
+
+struct StandinConfig {
+  std::vector<DeviceConfig> devices;
+  std::vector<LoopbackConfig> loopbacks;
+};
+
 // Reads and checks the file (every key, type and range; unknown keys are errors). Recordings are
 // not opened here. Throws StandinConfigError.
-std::vector<DeviceConfig> load_standin_config(const std::filesystem::path& file);
+StandinConfig load_standin_config(const std::filesystem::path& file);
 
 // The absolute, lexically normal form of a device path as the process would open it.
 std::string normal_device_path(const std::string& path);

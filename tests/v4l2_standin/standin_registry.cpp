@@ -12,6 +12,9 @@
 #include <chrono>
 #include <filesystem>
 
+#include "loopback_capture.h"
+#include "loopback_output.h"
+
 namespace arpipe::standin {
 
 namespace {
@@ -43,11 +46,20 @@ Registry& Registry::get() {
 }
 
 int Registry::load(const char* config_path, std::string& error) {
-  std::vector<std::shared_ptr<Device>> devices;
+  std::vector<std::shared_ptr<Node>> devices;
   try {
     // Recordings are opened without any lock held: their files go through our open().
-    for (DeviceConfig& config : load_standin_config(config_path))
-      devices.push_back(std::make_shared<Device>(std::move(config)));
+    StandinConfig config = load_standin_config(config_path);
+    for (DeviceConfig& device : config.devices) devices.push_back(std::make_shared<Device>(std::move(device)));
+    for (const LoopbackConfig& loopback : config.loopbacks) {
+      std::error_code ec;
+      std::filesystem::create_directories(loopback.spool, ec);
+      if (ec || !std::filesystem::is_directory(loopback.spool))
+        throw StandinConfigError(fmt::format("{}: cannot make the spool directory \"{}\": {}", loopback.place,
+                                             loopback.spool.string(), ec ? ec.message() : "not a directory"));
+      devices.push_back(std::make_shared<LoopbackOutput>(loopback));
+      devices.push_back(std::make_shared<LoopbackCapture>(loopback));
+    }
   } catch (const std::exception& e) {
     error = e.what();
     return -1;
@@ -76,7 +88,7 @@ void Registry::unload() {
   wake_.notify_all();
 }
 
-std::shared_ptr<Device> Registry::find_device(const std::string& path) const {
+std::shared_ptr<Node> Registry::find_device(const std::string& path) const {
   for (const auto& d : devices_)
     if (d->path() == path) return d;
   return nullptr;
@@ -161,7 +173,7 @@ int Registry::ioctl(int fd, unsigned long request, void* arg, bool& handled) {
   handled = it != files_.end();
   if (!handled) return -1;
   const std::shared_ptr<OpenFile> file = it->second;
-  Device& d = *file->device;
+  Node& d = *file->device;
   const int64_t now = monotonic_ns();
   d.present(now);
   d.advance(now);  // may unplug the device
@@ -217,7 +229,7 @@ int Registry::poll(pollfd* fds, nfds_t nfds, int timeout_ms, RealPoll real_poll)
         continue;
       }
       const OpenFile& file = *it->second;
-      Device& d = *file.device;
+      Node& d = *file.device;
       d.present(now);
       if (!file.dead) {
         d.advance(now);

@@ -1,4 +1,4 @@
-// The process-wide state of the stand-in: the served devices, the tracked file descriptors (a
+// The process-wide state of the stand-in: the served nodes (devices and loopback pairs), the tracked file descriptors (a
 // lock-free table for the interposer's fast path) and the one lock and wake-up the devices share.
 #pragma once
 
@@ -46,11 +46,11 @@ class Registry {
 
  private:
   Registry() = default;
-  std::shared_ptr<Device> find_device(const std::string& path) const;
+  std::shared_ptr<Node> find_device(const std::string& path) const;
 
   std::mutex mutex_;
   std::condition_variable wake_;
-  std::vector<std::shared_ptr<Device>> devices_;
+  std::vector<std::shared_ptr<Node>> devices_;
   std::unordered_map<int, std::shared_ptr<OpenFile>> files_;
   // The served paths, read by open() without the device lock (a recording's own files are
   // opened while it is held).

@@ -26,12 +26,13 @@ ARPIPE_V4L2_STANDIN_API void arpipe_v4l2_standin_unload(void);
 struct arpipe_v4l2_standin_stats {
   uint64_t opens;                     // successful opens of the device path
   uint64_t streamons;                 // successful VIDIOC_STREAMON calls that started streaming
-  uint64_t frames_delivered;          // buffers marked done (error buffers included)
+  uint64_t frames_delivered;          // buffers marked done (error buffers included); loopback capture: frames served
   uint64_t frames_dropped_no_buffer;  // frames that fell due with no buffer queued
   uint64_t frames_skipped_by_fault;   // frames skipped by "drop" faults
-  uint64_t error_buffers;             // buffers marked done with V4L2_BUF_FLAG_ERROR
+  uint64_t error_buffers;             // buffers marked done with V4L2_BUF_FLAG_ERROR (loopback output: frames not spooled)
   uint64_t control_events;            // V4L2_EVENT_CTRL events queued, summed over file handles
   uint64_t unplugs;                   // "unplug" faults that fired
+  uint64_t frames_written;            // loopback output: frames handed to the spool
 };
 // 0 and *out filled, or -1 (errno ENOENT) when device_path is not a served path.
 ARPIPE_V4L2_STANDIN_API int arpipe_v4l2_standin_stats(const char* device_path, struct arpipe_v4l2_standin_stats* out);
