@@ -140,4 +140,21 @@ void rgb24_to_i420(const uint8_t* rgb, int rgb_width, int width, int height, std
     }
 }
 
+void rgb24_to_yuyv(const uint8_t* rgb, size_t rgb_bytes_per_line, int width, int height, uint8_t* out,
+                   size_t out_bytes_per_line) {
+  for (int y = 0; y < height; ++y) {
+    const uint8_t* src = rgb + size_t(y) * rgb_bytes_per_line;
+    uint8_t* row = out + size_t(y) * out_bytes_per_line;
+    for (int x = 0; x + 1 < width; x += 2) {
+      const uint8_t* a = src + size_t(x) * 3;
+      const uint8_t* b = a + 3;
+      const int r = (a[0] + b[0] + 1) / 2, g = (a[1] + b[1] + 1) / 2, bl = (a[2] + b[2] + 1) / 2;
+      row[2 * x] = rgb_to_y(a[0], a[1], a[2]);
+      row[2 * x + 1] = rgb_to_u(r, g, bl);
+      row[2 * x + 2] = rgb_to_y(b[0], b[1], b[2]);
+      row[2 * x + 3] = rgb_to_v(r, g, bl);
+    }
+  }
+}
+
 }  // namespace arpipe

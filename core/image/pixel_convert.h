@@ -20,5 +20,10 @@ Frame from_rgb24(const uint8_t* rgb, int width, int height, PixelFormat format);
 // Planar 4:2:0 (I420, as Y4M wants it) from packed RGB24 whose rows are rgb_width pixels long:
 // the top-left width x height pixels (both even) become a Y plane, a U plane and a V plane.
 void rgb24_to_i420(const uint8_t* rgb, int rgb_width, int width, int height, std::vector<uint8_t>& out);
+// Packed YUYV 4:2:2 (BT.601 limited range, as every YUV conversion here; the same bytes as
+// from_rgb24(..., YUYV)) from RGB24 rows rgb_bytes_per_line apart: the top-left width x height
+// pixels (width even) become rows out_bytes_per_line apart in out. Each pair's chroma is the mean of its two pixels.
+void rgb24_to_yuyv(const uint8_t* rgb, size_t rgb_bytes_per_line, int width, int height, uint8_t* out,
+                   size_t out_bytes_per_line);
 
 }  // namespace arpipe
