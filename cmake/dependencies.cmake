@@ -18,6 +18,7 @@ pkg_check_modules(TURBOJPEG REQUIRED IMPORTED_TARGET libturbojpeg)  # MJPEG from
 pkg_check_modules(OPENEXR REQUIRED IMPORTED_TARGET OpenEXR)  # HDR light probes (.exr)
 pkg_check_modules(XXHASH REQUIRED IMPORTED_TARGET libxxhash)  # the PRT cache key: a hash of the mesh content
 pkg_check_modules(MICROHTTPD REQUIRED IMPORTED_TARGET libmicrohttpd)  # the live HTTP outputs (preview, MJPEG, metrics)
+pkg_check_modules(GSTREAMER REQUIRED IMPORTED_TARGET gstreamer-1.0 gstreamer-app-1.0)  # sinks.gstreamer: files, RTSP, encoders
 
 # mrcal ships no pkg-config or CMake file; -lmrcal pulls in libdogleg and CHOLMOD.
 find_library(MRCAL_LIBRARY mrcal REQUIRED)
@@ -40,4 +41,6 @@ find_path(TINYGLTF_INCLUDE_DIR tiny_gltf.h PATH_SUFFIXES tinygltf REQUIRED)
 
 if(ARPIPE_BUILD_TESTS)
   find_package(GTest REQUIRED)
+  # The GStreamer sink's RTSP round trip: a gst-rtsp-server in the test receives what it sends.
+  pkg_check_modules(GST_RTSP_SERVER REQUIRED IMPORTED_TARGET gstreamer-rtsp-server-1.0 gstreamer-app-1.0 gstreamer-rtp-1.0)
 endif()

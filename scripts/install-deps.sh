@@ -19,6 +19,9 @@ packages=(
   libcamera-dev libturbojpeg0-dev
   # live outputs: the HTTP preview, MJPEG, snapshots, state and Prometheus metrics
   libmicrohttpd-dev
+  # live outputs: the GStreamer sink (files, RTSP, encoders) with the common elements
+  libgstreamer1.0-dev libgstreamer-plugins-base1.0-dev gstreamer1.0-plugins-base
+  gstreamer1.0-plugins-good gstreamer1.0-plugins-ugly gstreamer1.0-rtsp
   # render: EGL + GLES 3 on Mesa (llvmpipe when there is no GPU)
   libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri libgbm1
   libtinygltf-dev libembree-dev libstb-dev libpng-dev
@@ -31,6 +34,8 @@ packages=(
   # the live outputs' tests: the preview page in a real headless browser, promtool (Prometheus'
   # own checker) on /metrics
   chromium-headless-shell prometheus
+  # the GStreamer sink's RTSP round trip (a gst-rtsp-server in the test)
+  libgstrtspserver-1.0-dev
 )
 
 sudo_cmd=()

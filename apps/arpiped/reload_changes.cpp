@@ -83,6 +83,8 @@ std::vector<std::string> changed_parts(const Config& running, const Config& next
   note(parts, "sinks.recording", a, b, [](const Config& c) { return c.sinks.recording; });
   note(parts, "sinks.results", a, b, [](const Config& c) { return c.sinks.results; });
   note(parts, "sinks.http", a, b, [](const Config& c) { return c.sinks.http; });
+  note(parts, "sinks.v4l2", a, b, [](const Config& c) { return c.sinks.v4l2; });
+  note(parts, "sinks.gstreamer", a, b, [](const Config& c) { return c.sinks.gstreamer; });
 
   note(parts, "pipeline.max_frames", a, b, [](const Config& c) { return c.pipeline.max_frames; });
   note(parts, "pipeline.log_level", a, b, [](const Config& c) { return c.pipeline.log_level; });

@@ -4,6 +4,7 @@
 
 #include "capture/live/live_source.h"
 #include "capture/replay_source.h"
+#include "capture/sinks/gstreamer/gstreamer_sink.h"
 #include "capture/sinks/http/http_sink.h"
 #include "capture/sinks/png_sink.h"
 #include "capture/sinks/recording_sink.h"
@@ -57,6 +58,7 @@ std::vector<SinkSlot> sink_slots(StatusProvider status) {
   // The live outputs read the running pipeline's status (counters, sinks, camera) for /state and /metrics.
   slots.push_back(slot("sinks.http", [](const Config& c) -> const auto& { return c.sinks.http; },
                        [status](const HttpSinkConfig& http) { return std::make_unique<HttpSink>(http, status); }));
+  slots.push_back(slot<GstreamerSink>("sinks.gstreamer", [](const Config& c) -> const auto& { return c.sinks.gstreamer; }));
   return slots;
 }
 

@@ -19,6 +19,7 @@
 #include "core/config/probe_kind.h"
 #include "core/config/probe_method.h"
 #include "core/config/shadow_method.h"
+#include "core/config/v4l2_output_format.h"
 #include "core/geometry/vec.h"
 #include "core/environment/environment_layout.h"
 #include "core/image/camera_response.h"
@@ -574,12 +575,50 @@ void visit(V& v, HttpSinkConfig& s) {
   v.key("camera_away_ms", s.camera_away_ms, IntRange{100, 600'000}, "no frame for this long: the stream shows a placeholder that says so");
 }
 
+// A V4L2 output device (a v4l2loopback node) that browsers, OBS or video calls open as a camera.
+struct V4l2SinkConfig {
+  bool enabled = false;  // on when the config has its table ([sinks.*] below)
+  std::filesystem::path device = "/dev/video10";
+  V4l2OutputFormat format = V4l2OutputFormat::Yuyv;
+
+  bool operator==(const V4l2SinkConfig&) const = default;
+};
+
+// Its keys, one row each: the name in the file, the member (whose initializer is the default), the
+// rule the value must meet, and the help `arpipe config --defaults` prints (docs/ARCHITECTURE.md, "Adding a config key").
+template <class V>
+void visit(V& v, V4l2SinkConfig& s) {
+  v.key("enabled", s.enabled, "write the composite to a V4L2 output device (v4l2loopback), a camera to other programs");
+  v.key("device", s.device, "the output device node");
+  v.key("format", s.format, kV4l2OutputFormatNames, "pixel format written: yuyv (what most readers take), rgb24 (exact)");
+}
+
+// A GStreamer pipeline fed through its appsrc: a file, an RTSP server, a hardware encoder.
+struct GstreamerSinkConfig {
+  bool enabled = false;  // on when the config has its table ([sinks.*] below)
+  std::string pipeline = "appsrc name=arpipe ! videoconvert ! x264enc tune=zerolatency speed-preset=ultrafast ! mp4mux ! filesink location=out/arpiped.mp4";
+  int eos_timeout_ms = 5'000;
+
+  bool operator==(const GstreamerSinkConfig&) const = default;
+};
+
+// Its keys, one row each: the name in the file, the member (whose initializer is the default), the
+// rule the value must meet, and the help `arpipe config --defaults` prints (docs/ARCHITECTURE.md, "Adding a config key").
+template <class V>
+void visit(V& v, GstreamerSinkConfig& s) {
+  v.key("enabled", s.enabled, "feed the composite to a GStreamer pipeline");
+  v.key("pipeline", s.pipeline, "gst-launch syntax, starting with \"appsrc name=arpipe\" (RGB frames, timestamps from the exposures)");
+  v.key("eos_timeout_ms", s.eos_timeout_ms, IntRange{0, 600'000}, "at the end, how long the pipeline may take to finish its file");
+}
+
 struct SinksConfig {
   PngSinkConfig png;
   Y4mSinkConfig y4m;
   RecordingSinkConfig recording;
   ResultsSinkConfig results;
   HttpSinkConfig http;
+  V4l2SinkConfig v4l2;
+  GstreamerSinkConfig gstreamer;
 
   bool operator==(const SinksConfig&) const = default;
 };
@@ -595,6 +634,8 @@ void visit(V& v, SinksConfig& s) {
   v.switched_section("recording", s.recording, "composited frames as a recording");
   v.switched_section("results", s.results, "per-frame pose, tracking state and timings as JSON lines");
   v.switched_section("http", s.http, "live outputs over HTTP: preview page, MJPEG, snapshots, state, Prometheus metrics");
+  v.switched_section("v4l2", s.v4l2, "the composite on a V4L2 output device (v4l2loopback): a camera for other programs");
+  v.switched_section("gstreamer", s.gstreamer, "the composite into a GStreamer pipeline (files, RTSP, hardware encoders)");
 }
 
 struct PipelineConfig {
