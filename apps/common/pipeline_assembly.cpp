@@ -9,6 +9,7 @@
 #include "capture/sinks/png_sink.h"
 #include "capture/sinks/recording_sink.h"
 #include "capture/sinks/results_sink.h"
+#include "capture/sinks/v4l2/v4l2_output_sink.h"
 #include "capture/sinks/y4m_sink.h"
 #include "core/light/light_stage.h"
 #include "core/motion/motion_stage.h"
@@ -58,6 +59,7 @@ std::vector<SinkSlot> sink_slots(StatusProvider status) {
   // The live outputs read the running pipeline's status (counters, sinks, camera) for /state and /metrics.
   slots.push_back(slot("sinks.http", [](const Config& c) -> const auto& { return c.sinks.http; },
                        [status](const HttpSinkConfig& http) { return std::make_unique<HttpSink>(http, status); }));
+  slots.push_back(slot<V4l2OutputSink>("sinks.v4l2", [](const Config& c) -> const auto& { return c.sinks.v4l2; }));
   slots.push_back(slot<GstreamerSink>("sinks.gstreamer", [](const Config& c) -> const auto& { return c.sinks.gstreamer; }));
   return slots;
 }
