@@ -15,6 +15,7 @@
 #include <stdexcept>
 
 #include "core/image/pixel_convert.h"
+#include "core/log.h"
 #include "core/pipeline/monotonic_clock.h"
 
 namespace arpipe {
@@ -59,8 +60,9 @@ V4l2OutputSink::V4l2OutputSink(const V4l2SinkConfig& config)
               "its readers keep the last frame written") {
   if (const std::string why = open_device(); !why.empty())
     throw std::runtime_error(fmt::format("{} = \"{}\": {}", kV4l2SinkKey, device_.string(), why));
-  // Where the driver lists what it takes (v4l2loopback does until a writer has chosen), the
-  // configured format must be among them.
+  // Where the driver lists what it takes without the configured format, say so now; the first
+  // frame's VIDIOC_S_FMT decides. Not a refusal: v4l2loopback lists only the format being written
+  // while another writer streams, as the sink a reload replaces still does when this one is made.
   std::vector<uint32_t> offered;
   for (uint32_t i = 0; i < 64; ++i) {
     v4l2_fmtdesc d{};
@@ -72,10 +74,8 @@ V4l2OutputSink::V4l2OutputSink(const V4l2SinkConfig& config)
   if (!offered.empty() && std::find(offered.begin(), offered.end(), fourcc_) == offered.end()) {
     std::string names;
     for (const uint32_t f : offered) names += (names.empty() ? "" : ", ") + v4l2_sink_fourcc_name(f);
-    const std::string device = device_.string();
-    close_device();
-    throw std::runtime_error(fmt::format("{} = \"{}\": the device does not take {} (sinks.v4l2.format); it offers {}",
-                                         kV4l2SinkKey, device, v4l2_sink_fourcc_name(fourcc_), names));
+    log::warn("{} = \"{}\": the device lists {}, not {} (sinks.v4l2.format); the first frame will tell", kV4l2SinkKey,
+              device_.string(), names, v4l2_sink_fourcc_name(fourcc_));
   }
 }
 

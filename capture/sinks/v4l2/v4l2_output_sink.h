@@ -19,9 +19,8 @@ class V4l2OutputSink : public FrameSink {
   // Buffers asked of the driver: enough that a reader a frame or two behind never holds up the sink.
   static constexpr uint32_t kBuffers = 4;
 
-  // Opens the device and checks that it is a streaming V4L2 video output (and, where it lists
-  // formats, that it takes the configured one). Throws std::runtime_error naming sinks.v4l2.device.
-  // The size is set from the first frame.
+  // Opens the device and checks that it is a streaming V4L2 video output. Throws
+  // std::runtime_error naming sinks.v4l2.device. Format and size are set with the first frame.
   explicit V4l2OutputSink(const V4l2SinkConfig& config);
   ~V4l2OutputSink() override;
   std::string describe() const override;
