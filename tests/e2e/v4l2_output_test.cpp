@@ -17,6 +17,7 @@
 #include <thread>
 #include <vector>
 
+#include <link.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -46,6 +47,24 @@ std::string program_path(const std::string& name) {
     if (::access(candidate.c_str(), X_OK) == 0) return candidate.string();
   }
   return "";
+}
+
+// The sanitizer runtime this test runs with ("" in a plain build). FFmpeg is not built with it, and
+// the stand-in of a sanitizer build needs it: it is preloaded first, as docs/V4L2_STANDIN.md says.
+std::string sanitizer_runtime() {
+#if defined(__SANITIZE_ADDRESS__)
+  std::string found;
+  dl_iterate_phdr(
+      [](dl_phdr_info* info, size_t, void* out) {
+        const std::string name = info->dlpi_name != nullptr ? info->dlpi_name : "";
+        if (name.find("libasan.so") != std::string::npos) *static_cast<std::string*>(out) = name;
+        return 0;
+      },
+      &found);
+  return found;
+#else
+  return "";
+#endif
 }
 
 class V4l2Output : public test::E2eTestDir {
@@ -81,12 +100,15 @@ class V4l2Output : public test::E2eTestDir {
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
     ASSERT_TRUE(fs::exists(dir_ / "spool" / "format")) << "the sink set no format within 120 s\n" << daemon.stderr_text();
     const std::string count = std::to_string(frames);
+    std::vector<std::string> reader_env = env;
+    if (const std::string runtime = sanitizer_runtime(); !runtime.empty())
+      reader_env[0] = "LD_PRELOAD=" + runtime + " " + kStandinLibrary.string();
     test::ChildProcess reader(ffmpeg,
                               {"-nostdin", "-hide_banner", "-loglevel", "error", "-copyts", "-f", "v4l2",
                                "-pixel_format", pixel_format, "-i", kCaptureNode,
                                "-map", "0:v", "-frames:v", count, "-c:v", "copy", "-f", "rawvideo", "-y", (dir_ / "frames.raw").string(),
                                "-map", "0:v", "-frames:v", count, "-c:v", "copy", "-f", "framemd5", "-y", (dir_ / "frames.md5").string()},
-                              dir_ / "ffmpeg", env);
+                              dir_ / "ffmpeg", reader_env);
     const int daemon_status = daemon.wait(std::chrono::seconds(600));
     ASSERT_TRUE(daemon_status != -1 && WIFEXITED(daemon_status) && WEXITSTATUS(daemon_status) == 0)
         << "arpiped: status " << daemon_status << "\n" << daemon.stderr_text();
