@@ -206,5 +206,46 @@ TEST_F(LoopbackTest, FramesPassInOrderAndADamagedSpoolFileIsAnErrorBuffer) {
   EXPECT_EQ(stats.error_buffers, 1u);
 }
 
+// A spool past max_spool_mib takes no more frames: their buffers come back with
+// V4L2_BUF_FLAG_ERROR and are counted; the writer never waits.
+TEST_F(LoopbackTest, AFullSpoolRefusesFramesWithErrorBuffers) {
+  load_loopback("max_spool_mib = 1\n");
+  const int fd = open_device(O_RDWR | O_NONBLOCK, kOut);
+  ASSERT_GE(fd, 0);
+  start_output(fd, V4L2_PIX_FMT_RGB24, 640, 480, 2);  // 921600 bytes a frame: one fits in 1 MiB
+  for (uint32_t i = 0; i < 3; ++i) {
+    v4l2_buffer b{};
+    b.index = i % 2;
+    b.type = V4L2_BUF_TYPE_VIDEO_OUTPUT;
+    b.memory = V4L2_MEMORY_MMAP;
+    b.bytesused = 640 * 480 * 3;
+    ASSERT_EQ(ioctl(fd, VIDIOC_QBUF, &b), 0) << strerror(errno);
+    b = {};
+    b.type = V4L2_BUF_TYPE_VIDEO_OUTPUT;
+    b.memory = V4L2_MEMORY_MMAP;
+    ASSERT_EQ(ioctl(fd, VIDIOC_DQBUF, &b), 0) << strerror(errno);
+    EXPECT_EQ((b.flags & V4L2_BUF_FLAG_ERROR) != 0, i > 0) << "frame " << i;
+  }
+  struct arpipe_v4l2_standin_stats stats{};
+  ASSERT_EQ(arpipe_v4l2_standin_stats(kOut, &stats), 0);
+  EXPECT_EQ(stats.frames_written, 1u);
+  EXPECT_EQ(stats.error_buffers, 2u);
+}
+
+// A damaged `format` file is no format: the capture node answers EINVAL and says why on stderr.
+TEST_F(LoopbackTest, ADamagedFormatFileIsNoFormat) {
+  load_loopback();
+  std::ofstream(dir_ / "spool" / "format", std::ios::binary) << std::string(64, 'x');
+  const int fd = open_device(O_RDWR | O_NONBLOCK, kCap);
+  ASSERT_GE(fd, 0);
+  ::testing::internal::CaptureStderr();
+  v4l2_format f{};
+  f.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+  EXPECT_EQ(ioctl(fd, VIDIOC_G_FMT, &f), -1);
+  EXPECT_EQ(errno, EINVAL);
+  const std::string said = ::testing::internal::GetCapturedStderr();
+  EXPECT_NE(said.find("spool/format: expected a spool file (magic \"ARPLOOP1\")"), std::string::npos) << said;
+}
+
 }  // namespace
 }  // namespace arpipe::standin_test
