@@ -668,9 +668,14 @@ TEST(PipelineRunner, UnhealthyWhileAStageIsStuckHealthyWhenIdle) {
 TEST(PipelineRunner, LiveCameraASlowSinkDropsItsOwnFramesAndNeverTheOthers) {
   constexpr uint64_t kFrames = 150;
   // The camera delivers a frame every millisecond: slower than the stages, far faster than the
-  // slow sink's 20 ms.
+  // slow sink's 20 ms. Each sink's queue holds 32 frames: the fast sink stays far from that even on a
+  // loaded machine (with 4, a fast sink's thread not scheduled for 4 ms dropped too: that is the
+  // policy working, not a slow sink's harm), the slow one, taking about 8 frames in the run, overflows it.
+  Config config = config_marked("run");
+  config.pipeline.sink_queue_depth = 32;
   Harness h(Setup::replaying(frames_0_to(kFrames), AfterScript::BlockUntilInterrupted)
                 .as_live_camera()
+                .with_config(config)
                 .pausing_source_with([](int) { std::this_thread::sleep_for(std::chrono::milliseconds(1)); })
                 .with_sink_delays({std::chrono::microseconds(0), std::chrono::microseconds(20'000)}));
   h.runner->start();
