@@ -11,6 +11,7 @@ packages=(
   libmrgingham-dev libeigen3-dev libsuitesparse-dev
   libtomlplusplus-dev nlohmann-json3-dev libsystemd-dev libfmt-dev
   libgeographiclib-dev
+  libbullet-dev  # rigid-body physics against the proxies (core/physics)
   # the command lines of arpipe and arpiped (header-only)
   libcli11-dev
   # HDR light probes (OpenEXR) and the PRT cache's content key (xxHash)
