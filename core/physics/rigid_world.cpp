@@ -60,9 +60,9 @@ btDefaultCollisionConfiguration* with_multipoint_contacts(btDefaultCollisionConf
 
 Vec3 from_bt_vector(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
 
-SE3 translation_only(const Vec3& t) { return SE3(identity3(), t); }
+SE3 rigid_translation(const Vec3& t) { return SE3(identity3(), t); }
 
-bool all_finite(const Vec3& v) { return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]); }
+bool rigid_state_finite(const Vec3& v) { return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]); }
 
 }  // namespace
 
@@ -161,7 +161,7 @@ struct RigidWorld::Impl {
       const Vec3 v = from_bt_vector(b.rigid->getLinearVelocity());
       const Vec3 w = from_bt_vector(b.rigid->getAngularVelocity());
       RemovalReason why = RemovalReason::None;
-      if (!all_finite(p) || !all_finite(v) || !all_finite(w)) why = RemovalReason::NonFinite;
+      if (!rigid_state_finite(p) || !rigid_state_finite(v) || !rigid_state_finite(w)) why = RemovalReason::NonFinite;
       else if (p[2] < settings.floor_limit_z_m) why = RemovalReason::BelowFloor;
       else if (norm(p) > settings.world_radius_m) why = RemovalReason::BeyondRadius;
       if (why == RemovalReason::None) continue;
@@ -251,7 +251,7 @@ size_t RigidWorld::add_collider(const ColliderSpec& spec) {
   c.object = std::make_unique<btCollisionObject>();
   c.object->setCollisionShape(c.shape.shape.get());
   c.object->setContactProcessingThreshold(kContactProcessingThresholdM);
-  c.object->setWorldTransform(to_bt_transform(spec.T_world_collider * translation_only(c.shape.centre_of_mass)));
+  c.object->setWorldTransform(to_bt_transform(spec.T_world_collider * rigid_translation(c.shape.centre_of_mass)));
   c.object->setRestitution(static_cast<btScalar>(spec.restitution));
   c.object->setFriction(static_cast<btScalar>(spec.friction));
   c.object->setRollingFriction(static_cast<btScalar>(spec.rolling_friction));
@@ -284,7 +284,7 @@ size_t RigidWorld::add_body(const RigidBodySpec& spec) {
   b.track = spec.track;
   b.T_world_body_initial = spec.T_world_body;
   b.shape = make_bullet_body_shape(spec.shape, who);
-  b.T_body_com = spec.T_body_shape * translation_only(b.shape.centre_of_mass);
+  b.T_body_com = spec.T_body_shape * rigid_translation(b.shape.centre_of_mass);
   b.T_com_body = b.T_body_com.inverse();
 
   const bool dynamic = spec.kind == BodyKind::Dynamic;
