@@ -3,7 +3,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
+#include <variant>
 
 #include "core/physics/physics_error.h"
 #include "core/physics/physics_limits.h"
