@@ -598,6 +598,7 @@ struct GstreamerSinkConfig {
   bool enabled = false;  // on when the config has its table ([sinks.*] below)
   std::string pipeline = "appsrc name=arpipe ! videoconvert ! x264enc tune=zerolatency speed-preset=ultrafast ! mp4mux ! filesink location=out/arpiped.mp4";
   int eos_timeout_ms = 5'000;
+  int restart_ms = 0;  // 0: a failed pipeline stays stopped
 
   bool operator==(const GstreamerSinkConfig&) const = default;
 };
@@ -608,7 +609,11 @@ template <class V>
 void visit(V& v, GstreamerSinkConfig& s) {
   v.key("enabled", s.enabled, "feed the composite to a GStreamer pipeline");
   v.key("pipeline", s.pipeline, "gst-launch syntax, starting with \"appsrc name=arpipe\" (RGB frames, timestamps from the exposures)");
-  v.key("eos_timeout_ms", s.eos_timeout_ms, IntRange{0, 600'000}, "at the end, how long the pipeline may take to finish its file");
+  v.key("eos_timeout_ms", s.eos_timeout_ms, IntRange{0, 600'000},
+        "how long the pipeline may take to finish its file at the end, and to take a frame before it is left out");
+  v.key("restart_ms", s.restart_ms, IntRange{0, 3'600'000},
+        "after a pipeline error, build it again this often until it runs (for network outputs: a file would be started "
+        "again); 0: stay stopped");
 }
 
 struct SinksConfig {

@@ -12,6 +12,7 @@
 
 #include "capture/sinks/gstreamer/gst_handles.h"
 #include "core/log.h"
+#include "core/pipeline/monotonic_clock.h"
 
 namespace arpipe {
 
@@ -31,8 +32,14 @@ size_t gst_rgb_stride(int width) { return (size_t(width) * 3 + 3) & ~size_t(3); 
 }  // namespace
 
 GstreamerSink::GstreamerSink(const GstreamerSinkConfig& config)
-    : pipeline_text_(config.pipeline), eos_timeout_ms_(config.eos_timeout_ms), gst_(std::make_unique<Gst>()) {
+    : pipeline_text_(config.pipeline),
+      eos_timeout_ms_(config.eos_timeout_ms),
+      restart_ms_(config.restart_ms),
+      gst_(build()) {}
+
+std::unique_ptr<GstreamerSink::Gst> GstreamerSink::build() const {
   ensure_gstreamer_initialised();
+  auto gst = std::make_unique<Gst>();
   GError* error = nullptr;
   GstElement* parsed = gst_parse_launch_full(pipeline_text_.c_str(), nullptr, GST_PARSE_FLAG_FATAL_ERRORS, &error);
   if (error) {
@@ -46,16 +53,17 @@ GstreamerSink::GstreamerSink(const GstreamerSinkConfig& config)
     gst_object_unref(parsed);
     throw std::runtime_error(fmt::format("{} = \"{}\": needs an appsrc named \"arpipe\" and something it feeds", kKey, pipeline_text_));
   }
-  gst_->pipeline.reset(parsed);
-  gst_->appsrc.reset(gst_bin_get_by_name(GST_BIN(parsed), "arpipe"));
-  if (!gst_->appsrc || !GST_IS_APP_SRC(gst_->appsrc.get()))
+  gst->pipeline.reset(parsed);
+  gst->appsrc.reset(gst_bin_get_by_name(GST_BIN(parsed), "arpipe"));
+  if (!gst->appsrc || !GST_IS_APP_SRC(gst->appsrc.get()))
     throw std::runtime_error(fmt::format("{} = \"{}\": no appsrc named \"arpipe\" (start it with \"appsrc name=arpipe ! ...\")", kKey, pipeline_text_));
   // Time-stamped buffers. appsrc's own blocking push could wait for ever on a stalled pipeline (and
   // with it the daemon's stop), so wait_for_room() waits, at most eos_timeout_ms.
-  g_object_set(gst_->appsrc.get(), "format", GST_FORMAT_TIME, "block", FALSE, "is-live", FALSE, "do-timestamp", FALSE, nullptr);
-  gst_->bus.reset(gst_element_get_bus(gst_->pipeline.get()));
+  g_object_set(gst->appsrc.get(), "format", GST_FORMAT_TIME, "block", FALSE, "is-live", FALSE, "do-timestamp", FALSE, nullptr);
+  gst->bus.reset(gst_element_get_bus(gst->pipeline.get()));
   // Left in NULL: a file sink opens (and truncates) its file on the way to READY, and the last
   // run's file must survive a start that fails later on.
+  return gst;
 }
 
 GstreamerSink::~GstreamerSink() {
@@ -68,9 +76,39 @@ std::string GstreamerSink::describe() const {
 }
 
 void GstreamerSink::fail(const std::string& why) noexcept {
-  if (!failed_) log::error("{}: the GStreamer pipeline stopped: {}; later frames are only counted", kKey, why);
+  if (!failed_) {
+    if (restart_ms_ > 0)
+      log::error("{}: the GStreamer pipeline stopped: {}; building it again every {} ms (sinks.gstreamer.restart_ms), frames "
+                 "meanwhile only counted", kKey, why, restart_ms_);
+    else
+      log::error("{}: the GStreamer pipeline stopped: {}; later frames are only counted (sinks.gstreamer.restart_ms = 0)", kKey, why);
+    failed_since_ns_ = monotonic_now_ns();
+  }
   failed_ = true;
   gst_element_set_state(gst_->pipeline.get(), GST_STATE_NULL);
+  if (restart_ms_ > 0) restart_at_ns_ = monotonic_now_ns() + int64_t(restart_ms_) * 1'000'000;
+}
+
+// A new pipeline from the same text, its time starting again at its first frame. A file sink's
+// file is opened (truncated) again: restart_ms is for network outputs (docs/OPERATIONS.md).
+void GstreamerSink::restart() noexcept {
+  if (!failed_ || ended_ || restart_ms_ <= 0 || monotonic_now_ns() < restart_at_ns_) return;
+  gst_element_set_state(gst_->pipeline.get(), GST_STATE_NULL);
+  try {
+    gst_ = build();
+  } catch (const std::exception&) {  // the same text built at start: only memory or plugins gone
+    restart_at_ns_ = monotonic_now_ns() + int64_t(restart_ms_) * 1'000'000;
+    return;
+  }
+  ++restarts_;
+  failed_ = false;
+  playing_ = false;
+  width_ = height_ = 0;
+  frames_since_start_ = 0;
+  last_pts_ns_ = -1;
+  run_started();
+  if (!failed_)
+    log::info("{}: the GStreamer pipeline runs again after {:.1f} s", kKey, double(monotonic_now_ns() - failed_since_ns_) * 1e-9);
 }
 
 void GstreamerSink::run_started() noexcept {
@@ -134,6 +172,7 @@ void GstreamerSink::consume_shared(const std::shared_ptr<const FrameContext>& ct
 void GstreamerSink::push(const FrameContext& ctx, const std::shared_ptr<const FrameContext>& shared) noexcept {
   run_started();
   check_bus();
+  restart();
   if (ctx.output.empty()) return;
   if (failed_ || ended_) {
     ++failures_;
@@ -182,7 +221,7 @@ void GstreamerSink::push(const FrameContext& ctx, const std::shared_ptr<const Fr
   }
   // Presentation time: the exposure start, from the first frame's; never backwards (a muxer refuses that).
   const int64_t exposure = frame.meta.exposure_start_ns;
-  if (frames_pushed_ == 0) first_exposure_ns_ = exposure;
+  if (frames_since_start_ == 0) first_exposure_ns_ = exposure;
   int64_t pts = exposure - first_exposure_ns_;
   if (pts <= last_pts_ns_) pts = last_pts_ns_ + 1;
   last_pts_ns_ = pts;
@@ -200,6 +239,7 @@ void GstreamerSink::push(const FrameContext& ctx, const std::shared_ptr<const Fr
     return;
   }
   ++frames_pushed_;
+  ++frames_since_start_;
 }
 
 void GstreamerSink::flush() noexcept {

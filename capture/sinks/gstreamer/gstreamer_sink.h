@@ -31,6 +31,7 @@ class GstreamerSink : public FrameSink {
   uint64_t frames_pushed() const { return frames_pushed_; }
   uint64_t frames_copied() const { return frames_copied_; }
   uint64_t failures() const { return failures_; }
+  uint64_t restarts() const { return restarts_; }  // pipelines built again after an error (restart_ms)
 
  private:
   // The one push path: `shared` keeps the frame alive while GStreamer holds its bytes (no copy);
@@ -41,10 +42,15 @@ class GstreamerSink : public FrameSink {
   bool wait_for_room() noexcept;
   void check_bus() noexcept;  // a pipeline error stops the sink (logged once, frames then counted)
   void fail(const std::string& why) noexcept;
+  // After an error, with restart_ms > 0: builds and starts the pipeline again once restart_ms passed.
+  void restart() noexcept;
 
   std::string pipeline_text_;
   int eos_timeout_ms_;
+  int restart_ms_;
   struct Gst;  // the pipeline, its appsrc and bus (GStreamer's headers stay out of this one)
+  // Parses the pipeline text; throws std::runtime_error naming sinks.gstreamer.pipeline.
+  std::unique_ptr<Gst> build() const;
   std::unique_ptr<Gst> gst_;
   bool playing_ = false;
   bool failed_ = false;
@@ -53,6 +59,10 @@ class GstreamerSink : public FrameSink {
   int64_t first_exposure_ns_ = 0;
   int64_t last_pts_ns_ = -1;
   uint64_t frames_pushed_ = 0;
+  uint64_t frames_since_start_ = 0;  // of this pipeline (a restart starts its time again)
+  uint64_t restarts_ = 0;
+  int64_t restart_at_ns_ = 0;
+  int64_t failed_since_ns_ = 0;
   uint64_t frames_copied_ = 0;
   uint64_t failures_ = 0;
   uint64_t stalls_ = 0;

@@ -6,10 +6,17 @@
 #include <gst/app/gstappsink.h>
 #include <gst/rtp/gstrtpbuffer.h>
 #include <gst/rtsp-server/rtsp-server.h>
+#include <arpa/inet.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
 #include <unistd.h>
 
+#include <atomic>
+#include <cerrno>
 #include <chrono>
+#include <cstring>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -276,6 +283,123 @@ TEST(GstreamerSink, RtspRoundTripOnLoopbackDeliversEveryFrame) {
 
 // A pipeline that stops taking frames (one buffer a second downstream) holds the sink at most
 // eos_timeout_ms per frame: the frame is counted as lost, the sink goes on, and it ends.
+// A TCP listener on loopback that collects what connects to it (a stand-in for a network receiver
+// that goes away and comes back), on a port fixed across its restarts.
+class TcpReceiver {
+ public:
+  explicit TcpReceiver(uint16_t port = 0) {
+    listen_fd_ = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    const int one = 1;
+    ::setsockopt(listen_fd_, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
+    sockaddr_in address{};
+    address.sin_family = AF_INET;
+    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    address.sin_port = htons(port);
+    if (::bind(listen_fd_, reinterpret_cast<sockaddr*>(&address), sizeof address) != 0 || ::listen(listen_fd_, 4) != 0) {
+      ADD_FAILURE() << "cannot listen on 127.0.0.1:" << port << ": " << std::strerror(errno);
+      return;
+    }
+    socklen_t length = sizeof address;
+    ::getsockname(listen_fd_, reinterpret_cast<sockaddr*>(&address), &length);
+    port_ = ntohs(address.sin_port);
+    thread_ = std::thread([this] {
+      pollfd fds{listen_fd_, POLLIN, 0};
+      if (::poll(&fds, 1, 10'000) != 1) return;  // bounded: a sink that never connects fails the test
+      const int client = ::accept4(listen_fd_, nullptr, nullptr, SOCK_CLOEXEC);
+      if (client < 0) return;
+      client_fd_ = client;
+      char chunk[65536];
+      for (;;) {
+        pollfd in{client, POLLIN, 0};
+        if (::poll(&in, 1, 200) == 0) {
+          if (stop_) break;
+          continue;
+        }
+        const ssize_t n = ::recv(client, chunk, sizeof chunk, 0);
+        if (n <= 0) break;
+        std::lock_guard lock(mutex_);
+        bytes_.append(chunk, size_t(n));
+      }
+    });
+  }
+  ~TcpReceiver() { close(); }
+  // Goes away: the connection and the listening socket closed (the sender's next writes fail).
+  void close() {
+    stop_ = true;
+    if (thread_.joinable()) thread_.join();
+    if (client_fd_ >= 0) ::close(client_fd_);
+    if (listen_fd_ >= 0) ::close(listen_fd_);
+    client_fd_ = listen_fd_ = -1;
+  }
+  uint16_t port() const { return port_; }
+  std::string bytes() {
+    std::lock_guard lock(mutex_);
+    return bytes_;
+  }
+
+ private:
+  int listen_fd_ = -1;
+  int client_fd_ = -1;
+  uint16_t port_ = 0;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+  std::mutex mutex_;
+  std::string bytes_;
+};
+
+// restart_ms: a receiver that goes away stops the pipeline (counted), and once it is back the sink
+// builds the pipeline again and whole frames flow to it, in order.
+TEST(GstreamerSink, ARestartedPipelineReachesAReceiverThatCameBack) {
+  constexpr int kWidth = 64, kHeight = 48;
+  constexpr size_t kFrameBytes = size_t(kWidth) * kHeight * 3;
+  auto first = std::make_unique<TcpReceiver>();
+  const uint16_t port = first->port();
+  GstreamerSinkConfig config = pipeline(fmt::format("appsrc name=arpipe ! tcpclientsink host=127.0.0.1 port={} sync=false", port));
+  config.restart_ms = 200;
+  GstreamerSink sink(config);
+  std::vector<std::string> sent;
+  uint64_t index = 0;
+  const auto send = [&] {
+    auto ctx = frame(index++, kWidth, kHeight);
+    sent.push_back(packed(ctx->output));
+    sink.consume_shared(ctx);
+  };
+  for (int i = 0; i < 5; ++i) send();
+  for (int i = 0; i < 100 && first->bytes().size() < 5 * kFrameBytes; ++i) std::this_thread::sleep_for(20ms);
+  ASSERT_EQ(first->bytes().size(), 5 * kFrameBytes);
+  EXPECT_TRUE(first->bytes() == sent[0] + sent[1] + sent[2] + sent[3] + sent[4]);
+
+  // The receiver goes away: writes fail within a few frames.
+  first->close();
+  for (int i = 0; i < 100 && sink.failures() == 0; ++i) {
+    send();
+    std::this_thread::sleep_for(20ms);
+  }
+  ASSERT_GT(sink.failures(), 0u);
+  EXPECT_EQ(sink.restarts(), 0u);
+
+  // Back on the same port: within a few restart periods the sink reaches it, and whole frames
+  // arrive, each one of those sent, in order.
+  TcpReceiver second(port);
+  for (int i = 0; i < 150 && second.bytes().size() < 3 * kFrameBytes; ++i) {
+    send();
+    std::this_thread::sleep_for(20ms);
+  }
+  EXPECT_GE(sink.restarts(), 1u);
+  std::string got = second.bytes();
+  ASSERT_GE(got.size(), 3 * kFrameBytes);
+  got.resize(got.size() / kFrameBytes * kFrameBytes);
+  size_t next = 0;
+  for (size_t at = 0; at < got.size(); at += kFrameBytes) {
+    const std::string received = got.substr(at, kFrameBytes);
+    size_t found = next;
+    while (found < sent.size() && sent[found] != received) ++found;
+    ASSERT_LT(found, sent.size()) << "received frame " << at / kFrameBytes << " is none of those sent after the last";
+    next = found + 1;
+  }
+  sink.flush();
+}
+
 TEST(GstreamerSink, AStalledPipelineNeverHoldsTheSinkLongerThanItsTimeout) {
   GstreamerSinkConfig config = pipeline("appsrc name=arpipe ! queue max-size-buffers=1 ! identity sleep-time=1000000 ! fakesink");
   config.eos_timeout_ms = 200;
