@@ -105,7 +105,8 @@ std::string V4l2OutputSink::open_device() {
     const std::string why = fmt::format(
         "\"{}\" is not a streaming video output device (capabilities 0x{:08x}: expected VIDEO_OUTPUT and STREAMING); "
         "is it the loopback's own node?",
-        reinterpret_cast<const char*>(cap.card), caps);
+        std::string(reinterpret_cast<const char*>(cap.card), strnlen(reinterpret_cast<const char*>(cap.card), sizeof cap.card)),
+        caps);
     close_device();
     return why;
   }
