@@ -18,6 +18,7 @@ void add_benchmarks(CLI::App& bench) {
   add_calib_solve_benchmark(bench);
   add_sh_benchmark(bench);
   add_prt_benchmark(bench);
+  add_physics_benchmark(bench);
 }
 
 }  // namespace arpipe

@@ -24,5 +24,6 @@ void add_calib_corners_benchmark(CLI::App& bench);  // calib-corners: corner acc
 void add_calib_solve_benchmark(CLI::App& bench);    // calib-solve: calibration solve against views (calib_solve.cpp)
 void add_sh_benchmark(CLI::App& bench);             // sh: spherical-harmonic error against bands (sh_accuracy.cpp)
 void add_prt_benchmark(CLI::App& bench);            // prt: PRT bake time against error, run-time cost (prt_bake_accuracy.cpp)
+void add_physics_benchmark(CLI::App& bench);        // physics: time per frame against bounce error, per substep rate (physics_cost.cpp)
 
 }  // namespace arpipe

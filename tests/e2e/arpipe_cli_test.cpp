@@ -210,7 +210,7 @@ TEST_F(ArpipeCli, VersionAndHelpOfEveryCommand) {
   }
   if (!benchmarks_built()) return;
   for (const char* bench : {"pipeline", "scaling", "latency", "pose", "sim-render", "blur", "shadows", "probe", "sun",
-                            "capture-path", "calib-corners", "calib-solve", "sh", "prt"}) {
+                            "capture-path", "calib-corners", "calib-solve", "sh", "prt", "physics"}) {
     std::string help;
     EXPECT_EQ(run({"bench", bench, "--help"}, &help, &err), 0) << bench << ": " << err;
     EXPECT_NE(help.find(std::string("Usage: arpipe bench ") + bench), std::string::npos) << help;
@@ -248,6 +248,21 @@ TEST_F(ArpipeCli, BenchSunPrintsItsTable) {
   ASSERT_EQ(run({"bench", "sun", "--calls", "200", "--repeats", "3"}, &out, &err), 0) << err;
   EXPECT_NE(out.find("| NREL SPA (topocentric, refraction) |"), std::string::npos) << out;
   EXPECT_NE(out.find("| PSA (seed 001) |"), std::string::npos) << out;
+}
+
+// The physics table: at the default 960 substeps per second the ball's bounce is within the issue's
+// 1 % of e^2 h (the tests in tests/physics hold the same bound).
+TEST_F(ArpipeCli, BenchPhysicsPrintsItsTable) {
+  if (!benchmarks_built()) GTEST_SKIP() << "arpipe built without the benchmarks";
+  std::string out, err;
+  ASSERT_EQ(run({"bench", "physics", "--seconds", "0.5"}, &out, &err), 0) << err;
+  const size_t row = out.find("\n| 960 | ");
+  ASSERT_NE(row, std::string::npos) << out;
+  // "| 960 | MS | BOUNCE % | LANDING ms |"
+  const size_t bounce_at = out.find(" | ", out.find(" | ", row + 8) + 3);
+  ASSERT_NE(bounce_at, std::string::npos) << out;
+  const double bounce_percent = std::stod(out.substr(bounce_at + 3));
+  EXPECT_LT(bounce_percent, 1.0) << out;
 }
 
 TEST_F(ArpipeCli, DaemonPrintsItsVersionAndHelp) {
