@@ -19,49 +19,16 @@ constexpr uint32_t kLoopbackCaptureMaxBuffers = 32;  // VIDEO_MAX_FRAME
 // How often a stream waiting for the writer looks at the spool (the writer may be another process).
 constexpr int64_t kSpoolLookNs = 5000000;
 
-void loopback_capture_copy_name(uint8_t* dst, size_t size, const std::string& text) {
-  std::memset(dst, 0, size);
-  std::memcpy(dst, text.data(), std::min(text.size(), size - 1));
-}
-
 std::string loopback_format_phrase(const SpoolFormat& f) {
   return fmt::format("{} {}x{} ({} bytes a line)", pixel_format_name(f.format), f.width, f.height, f.bytes_per_line);
 }
 
 }  // namespace
 
-LoopbackCapture::LoopbackCapture(const LoopbackConfig& config) : config_(config), reader_(config_.spool) {}
+LoopbackCapture::LoopbackCapture(const LoopbackConfig& config)
+    : LoopbackNode(kLoopbackCaptureType, POLLIN | POLLRDNORM, PROT_READ), config_(config), reader_(config_.spool) {}
 
-void LoopbackCapture::attach(OpenFile& file) {
-  files_.push_back(&file);
-  ++open_count_;
-  ++stats.opens;
-}
-
-void LoopbackCapture::detach(OpenFile& file) {
-  --open_count_;
-  std::erase(files_, &file);
-  if (owner_ == &file) {
-    stop_streaming();
-    buffers_.release();
-    negotiated_.reset();
-    owner_ = nullptr;
-  }
-}
-
-void LoopbackCapture::disconnect_all() {
-  for (OpenFile* f : files_) f->dead = true;
-  files_.clear();
-  stop_streaming();
-  buffers_.release();
-  negotiated_.reset();
-  owner_ = nullptr;
-}
-
-void LoopbackCapture::stop_streaming() {
-  streaming_ = false;
-  buffers_.return_all();
-}
+void LoopbackCapture::queue_released() { negotiated_.reset(); }
 
 std::optional<SpoolFormat> LoopbackCapture::current_format() {
   if (negotiated_) return negotiated_;
@@ -119,9 +86,9 @@ int LoopbackCapture::ioctl(OpenFile& file, unsigned long request, void* arg, con
     case VIDIOC_QUERYCAP: {
       auto& cap = *static_cast<v4l2_capability*>(arg);
       std::memset(&cap, 0, sizeof cap);
-      loopback_capture_copy_name(cap.driver, sizeof cap.driver, "arpipe-standin");
-      loopback_capture_copy_name(cap.card, sizeof cap.card, config_.card);
-      loopback_capture_copy_name(cap.bus_info, sizeof cap.bus_info, config_.bus_info);
+      copy_name(cap.driver, sizeof cap.driver, "arpipe-standin");
+      copy_name(cap.card, sizeof cap.card, config_.card);
+      copy_name(cap.bus_info, sizeof cap.bus_info, config_.bus_info);
       cap.version = LINUX_VERSION_CODE;
       cap.device_caps = V4L2_CAP_VIDEO_CAPTURE | V4L2_CAP_STREAMING | V4L2_CAP_EXT_PIX_FORMAT;
       cap.capabilities = cap.device_caps | V4L2_CAP_DEVICE_CAPS;
@@ -134,7 +101,7 @@ int LoopbackCapture::ioctl(OpenFile& file, unsigned long request, void* arg, con
       std::memset(&d, 0, sizeof d);
       d.type = kLoopbackCaptureType;
       d.pixelformat = pixel_format_fourcc(format->format);
-      loopback_capture_copy_name(d.description, sizeof d.description, std::string(pixel_format_name(format->format)));
+      copy_name(d.description, sizeof d.description, std::string(pixel_format_name(format->format)));
       return 0;
     }
     case VIDIOC_ENUM_FRAMESIZES: {
@@ -189,7 +156,7 @@ int LoopbackCapture::ioctl(OpenFile& file, unsigned long request, void* arg, con
       auto& in = *static_cast<v4l2_input*>(arg);
       if (in.index != 0) return EINVAL;
       std::memset(&in, 0, sizeof in);
-      loopback_capture_copy_name(in.name, sizeof in.name, "loopback");
+      copy_name(in.name, sizeof in.name, "loopback");
       in.type = V4L2_INPUT_TYPE_CAMERA;
       return 0;
     }
@@ -276,42 +243,6 @@ int LoopbackCapture::qbuf(OpenFile& file, v4l2_buffer& b) {
   buffers_.fill(b.index, kLoopbackCaptureType, b);
   advance(monotonic_ns());
   return 0;
-}
-
-int LoopbackCapture::dqbuf(OpenFile& file, v4l2_buffer& b, const Waiter& wait) {
-  if (b.type != kLoopbackCaptureType || b.memory != V4L2_MEMORY_MMAP) return EINVAL;
-  if (busy(file)) return EBUSY;
-  const bool may_block = blocking_file(file);
-  for (;;) {
-    if (file.dead) return EIO;
-    if (!streaming_) return EINVAL;
-    if (!buffers_.done.empty()) {
-      const uint32_t index = buffers_.done.front();
-      buffers_.done.pop_front();
-      buffers_.state(index).done = false;
-      buffers_.fill(index, kLoopbackCaptureType, b);
-      return 0;
-    }
-    if (!may_block) return EAGAIN;
-    wait(next_wake(monotonic_ns()));
-    advance(monotonic_ns());
-  }
-}
-
-short LoopbackCapture::poll_events(const OpenFile& file, short requested) const {
-  if (file.dead) return POLLERR | POLLHUP;
-  short r = 0;
-  if (requested & (POLLIN | POLLRDNORM)) {
-    if (!streaming_)
-      r |= POLLERR;
-    else if (!buffers_.done.empty())
-      r |= POLLIN | POLLRDNORM;
-  }
-  return short(r & (requested | POLLERR | POLLHUP));
-}
-
-void* LoopbackCapture::mmap(void* addr, size_t length, int prot, int flags, int64_t offset) {
-  return buffers_.map(addr, length, prot, flags, offset, PROT_READ);
 }
 
 }  // namespace arpipe::standin

@@ -17,11 +17,6 @@ namespace {
 constexpr uint32_t kLoopbackOutputType = V4L2_BUF_TYPE_VIDEO_OUTPUT;
 constexpr uint32_t kLoopbackOutputMaxBuffers = 32;  // VIDEO_MAX_FRAME
 
-void loopback_output_copy_name(uint8_t* dst, size_t size, const std::string& text) {
-  std::memset(dst, 0, size);
-  std::memcpy(dst, text.data(), std::min(text.size(), size - 1));
-}
-
 PixelFormat loopback_raw_format(OfferedFormatName name) {
   switch (name) {
     case OfferedFormatName::Rgb24: return PixelFormat::RGB24;
@@ -51,36 +46,13 @@ const char* loopback_format_description(PixelFormat f) {
 }  // namespace
 
 LoopbackOutput::LoopbackOutput(const LoopbackConfig& config)
-    : config_(config),
+    : LoopbackNode(kLoopbackOutputType, POLLOUT | POLLWRNORM, PROT_WRITE),
+      config_(config),
       writer_(config_.spool, config_.max_spool_bytes),
       format_(spool_format(offered(0), std::min(640, config_.max_width) & ~1, std::min(480, config_.max_height) & ~1)),
       stall_fired_(config_.stalls.size(), false) {}
 
 PixelFormat LoopbackOutput::offered(size_t index) const { return loopback_raw_format(config_.formats[index]); }
-
-void LoopbackOutput::attach(OpenFile& file) {
-  files_.push_back(&file);
-  ++open_count_;
-  ++stats.opens;
-}
-
-void LoopbackOutput::detach(OpenFile& file) {
-  --open_count_;
-  std::erase(files_, &file);
-  if (owner_ == &file) {  // vb2_fop_release: the owner's close stops the stream and frees the queue
-    streaming_ = false;
-    buffers_.release();
-    owner_ = nullptr;
-  }
-}
-
-void LoopbackOutput::disconnect_all() {
-  for (OpenFile* f : files_) f->dead = true;
-  files_.clear();
-  streaming_ = false;
-  buffers_.release();
-  owner_ = nullptr;
-}
 
 int64_t LoopbackOutput::next_wake(int64_t now) const {
   if (streaming_ && !buffers_.queued.empty() && hold_until_ > now) return hold_until_;
@@ -144,9 +116,9 @@ int LoopbackOutput::ioctl(OpenFile& file, unsigned long request, void* arg, cons
     case VIDIOC_QUERYCAP: {
       auto& cap = *static_cast<v4l2_capability*>(arg);
       std::memset(&cap, 0, sizeof cap);
-      loopback_output_copy_name(cap.driver, sizeof cap.driver, "arpipe-standin");
-      loopback_output_copy_name(cap.card, sizeof cap.card, config_.card);
-      loopback_output_copy_name(cap.bus_info, sizeof cap.bus_info, config_.bus_info);
+      copy_name(cap.driver, sizeof cap.driver, "arpipe-standin");
+      copy_name(cap.card, sizeof cap.card, config_.card);
+      copy_name(cap.bus_info, sizeof cap.bus_info, config_.bus_info);
       cap.version = LINUX_VERSION_CODE;
       cap.device_caps = V4L2_CAP_VIDEO_OUTPUT | V4L2_CAP_STREAMING | V4L2_CAP_EXT_PIX_FORMAT;
       cap.capabilities = cap.device_caps | V4L2_CAP_DEVICE_CAPS;
@@ -160,7 +132,7 @@ int LoopbackOutput::ioctl(OpenFile& file, unsigned long request, void* arg, cons
       d.index = index;
       d.type = kLoopbackOutputType;
       d.pixelformat = pixel_format_fourcc(offered(index));
-      loopback_output_copy_name(d.description, sizeof d.description, loopback_format_description(offered(index)));
+      copy_name(d.description, sizeof d.description, loopback_format_description(offered(index)));
       return 0;
     }
     case VIDIOC_ENUM_FRAMESIZES: return enum_framesizes(*static_cast<v4l2_frmsizeenum*>(arg));
@@ -189,7 +161,7 @@ int LoopbackOutput::ioctl(OpenFile& file, unsigned long request, void* arg, cons
       auto& out = *static_cast<v4l2_output*>(arg);
       if (out.index != 0) return EINVAL;
       std::memset(&out, 0, sizeof out);
-      loopback_output_copy_name(out.name, sizeof out.name, "loopback in");
+      copy_name(out.name, sizeof out.name, "loopback in");
       out.type = V4L2_OUTPUT_TYPE_ANALOG;
       return 0;
     }
@@ -210,8 +182,7 @@ int LoopbackOutput::ioctl(OpenFile& file, unsigned long request, void* arg, cons
     case VIDIOC_STREAMOFF:
       if (*static_cast<int*>(arg) != int(kLoopbackOutputType)) return EINVAL;
       if (busy(file)) return EBUSY;
-      streaming_ = false;
-      buffers_.return_all();  // frames still queued are not written
+      stop_streaming();  // frames still queued are not written
       return 0;
     default: return ENOTTY;
   }
@@ -321,26 +292,6 @@ int LoopbackOutput::qbuf(OpenFile& file, v4l2_buffer& b) {
   return 0;
 }
 
-int LoopbackOutput::dqbuf(OpenFile& file, v4l2_buffer& b, const Waiter& wait) {
-  if (b.type != kLoopbackOutputType || b.memory != V4L2_MEMORY_MMAP) return EINVAL;
-  if (busy(file)) return EBUSY;
-  const bool may_block = blocking_file(file);
-  for (;;) {
-    if (file.dead) return EIO;
-    if (!streaming_) return EINVAL;
-    if (!buffers_.done.empty()) {
-      const uint32_t index = buffers_.done.front();
-      buffers_.done.pop_front();
-      buffers_.state(index).done = false;
-      buffers_.fill(index, kLoopbackOutputType, b);
-      return 0;
-    }
-    if (!may_block) return EAGAIN;
-    wait(next_wake(monotonic_ns()));
-    advance(monotonic_ns());
-  }
-}
-
 int LoopbackOutput::streamon(OpenFile& file) {
   if (busy(file)) return EBUSY;
   if (buffers_.empty()) return EINVAL;
@@ -352,22 +303,6 @@ int LoopbackOutput::streamon(OpenFile& file) {
   save_format();
   advance(monotonic_ns());
   return 0;
-}
-
-short LoopbackOutput::poll_events(const OpenFile& file, short requested) const {
-  if (file.dead) return POLLERR | POLLHUP;
-  short r = 0;
-  if (requested & (POLLOUT | POLLWRNORM)) {
-    if (!streaming_)
-      r |= POLLERR;  // vb2: nothing to wait for
-    else if (!buffers_.done.empty())
-      r |= POLLOUT | POLLWRNORM;
-  }
-  return short(r & (requested | POLLERR | POLLHUP));
-}
-
-void* LoopbackOutput::mmap(void* addr, size_t length, int prot, int flags, int64_t offset) {
-  return buffers_.map(addr, length, prot, flags, offset, PROT_WRITE);
 }
 
 }  // namespace arpipe::standin

@@ -9,27 +9,19 @@
 #include <vector>
 
 #include "loopback_spool.h"
-#include "mmap_buffers.h"
-#include "served_node.h"
+#include "loopback_node.h"
 #include "standin_config.h"
 
 namespace arpipe::standin {
 
-class LoopbackOutput final : public Node {
+class LoopbackOutput final : public LoopbackNode {
  public:
   explicit LoopbackOutput(const LoopbackConfig& config);
 
   const std::string& path() const override { return config_.output; }
-  bool present(int64_t) override { return true; }
-  void attach(OpenFile& file) override;
-  void detach(OpenFile& file) override;
-  bool open() const override { return open_count_ > 0; }
-  void disconnect_all() override;
   void advance(int64_t now) override;
   int64_t next_wake(int64_t now) const override;
   int ioctl(OpenFile& file, unsigned long request, void* arg, const Waiter& wait) override;
-  short poll_events(const OpenFile& file, short requested) const override;
-  void* mmap(void* addr, size_t length, int prot, int flags, int64_t offset) override;
 
  private:
   PixelFormat offered(size_t index) const;
@@ -39,20 +31,13 @@ class LoopbackOutput final : public Node {
   int parm(v4l2_streamparm& p, bool set);
   int reqbufs(OpenFile& file, v4l2_requestbuffers& r);
   int qbuf(OpenFile& file, v4l2_buffer& b);
-  int dqbuf(OpenFile& file, v4l2_buffer& b, const Waiter& wait);
   int streamon(OpenFile& file);
   void take(uint32_t index, int64_t now);
   void save_format();
-  bool busy(const OpenFile& file) const { return owner_ != nullptr && owner_ != &file; }
 
   LoopbackConfig config_;
   SpoolWriter writer_;
   SpoolFormat format_;
-  std::vector<OpenFile*> files_;
-  int open_count_ = 0;
-  OpenFile* owner_ = nullptr;  // the file handle that allocated the buffers (vb2's queue owner)
-  MmapBuffers buffers_;
-  bool streaming_ = false;
   uint32_t sequence_ = 0;         // frames taken since STREAMON
   uint64_t taken_ = 0;            // frames taken since the configuration was loaded (stall faults count these)
   std::vector<bool> stall_fired_;

@@ -2,7 +2,6 @@
 
 #include <fmt/format.h>
 #include <gst/app/gstappsrc.h>
-#include <gst/video/video-info.h>
 
 #include <chrono>
 #include <cstring>
@@ -131,7 +130,7 @@ void GstreamerSink::check_bus() noexcept {
   }
 }
 
-bool GstreamerSink::set_caps(const Frame& first) noexcept {
+void GstreamerSink::set_caps(const Frame& first) noexcept {
   width_ = first.width;
   height_ = first.height;
   // The frame rate from the camera's frame interval (variable, 0/1, when unknown): encoders use it for
@@ -151,7 +150,6 @@ bool GstreamerSink::set_caps(const Frame& first) noexcept {
   gst_caps_unref(caps);
   max_queued_bytes_ = 3 * gst_rgb_stride(width_) * size_t(height_);
   g_object_set(gst_->appsrc.get(), "max-bytes", guint64(2 * max_queued_bytes_), nullptr);
-  return true;
 }
 
 bool GstreamerSink::wait_for_room() noexcept {

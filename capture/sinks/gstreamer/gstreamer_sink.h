@@ -37,7 +37,7 @@ class GstreamerSink : public FrameSink {
   // The one push path: `shared` keeps the frame alive while GStreamer holds its bytes (no copy);
   // without it the bytes are copied.
   void push(const FrameContext& ctx, const std::shared_ptr<const FrameContext>& shared) noexcept;
-  bool set_caps(const Frame& first) noexcept;
+  void set_caps(const Frame& first) noexcept;  // the stream's caps from its first frame
   // Waits until the pipeline holds fewer than three frames, at most eos_timeout_ms; false if not.
   bool wait_for_room() noexcept;
   void check_bus() noexcept;  // a pipeline error stops the sink (logged once, frames then counted)
