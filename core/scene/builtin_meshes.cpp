@@ -3,6 +3,7 @@
 // base on z = 0, centred on the object origin in x and y, about 6 cm across.
 #include "core/scene/builtin_meshes.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace arpipe {
@@ -17,6 +18,7 @@ class MeshBuilder {
     }
     return static_cast<uint32_t>(mesh_.vertex_count() - 1);
   }
+  size_t vertex_count() const { return mesh_.vertex_count(); }
   void add_triangle(uint32_t a, uint32_t b, uint32_t c) { mesh_.indices.insert(mesh_.indices.end(), {a, b, c}); }
 
   // Flat parallelogram origin + s*u + t*v, s and t in [0, 1]; u x v points outwards.
@@ -138,6 +140,74 @@ Mesh make_plane_mesh(double edge_m, int subdivisions) {
   return builder.finish();
 }
 
+Mesh make_box_mesh(const Vec3& size_m, int subdivisions) {
+  const double x = size_m[0], y = size_m[1], z = size_m[2], hx = x / 2, hy = y / 2;
+  MeshBuilder builder;
+  builder.add_grid({-hx, -hy, z}, {x, 0, 0}, {0, y, 0}, subdivisions);  // top, +z
+  builder.add_grid({-hx, -hy, 0}, {0, y, 0}, {x, 0, 0}, subdivisions);  // bottom, -z
+  builder.add_grid({hx, -hy, 0}, {0, y, 0}, {0, 0, z}, subdivisions);   // +x
+  builder.add_grid({-hx, -hy, 0}, {0, 0, z}, {0, y, 0}, subdivisions);  // -x
+  builder.add_grid({-hx, hy, 0}, {0, 0, z}, {x, 0, 0}, subdivisions);   // +y
+  builder.add_grid({-hx, -hy, 0}, {x, 0, 0}, {0, 0, z}, subdivisions);  // -y
+  return builder.finish();
+}
+
+Mesh make_rectangle_mesh(double x_m, double y_m, int subdivisions) {
+  MeshBuilder builder;
+  builder.add_grid({-x_m / 2, -y_m / 2, 0}, {x_m, 0, 0}, {0, y_m, 0}, subdivisions);  // facing +z
+  return builder.finish();
+}
+
+Mesh make_cylinder_mesh(const Vec3& size_m, int segments, int subdivisions) {
+  const double a = size_m[0] / 2, b = size_m[1] / 2, height = size_m[2];
+  const double pi = 3.14159265358979323846;
+  segments = std::max(segments, 3);
+  subdivisions = std::max(subdivisions, 1);
+  MeshBuilder builder;
+  // The side: `subdivisions` rings up the height (lens distortion bends long edges), smooth
+  // normals of the ellipse (x / a^2, y / b^2).
+  const uint32_t side = static_cast<uint32_t>(builder.vertex_count());
+  for (int j = 0; j <= subdivisions; ++j)
+    for (int i = 0; i <= segments; ++i) {
+      // The seam's column repeats the first by value, so the surface welds closed there.
+      const double phi = 2 * pi * (i % segments) / segments, c = std::cos(phi), s = std::sin(phi);
+      builder.add_vertex({a * c, b * s, height * j / subdivisions}, normalized(Vec3{c / a, s / b, 0}));
+    }
+  auto at = [&](int i, int j) { return side + static_cast<uint32_t>(j * (segments + 1) + i); };
+  for (int j = 0; j < subdivisions; ++j)
+    for (int i = 0; i < segments; ++i) {  // counter-clockwise seen from outside
+      builder.add_triangle(at(i, j), at(i + 1, j), at(i + 1, j + 1));
+      builder.add_triangle(at(i, j), at(i + 1, j + 1), at(i, j + 1));
+    }
+  // The caps: fans from the centre, split into rings so that no edge is long.
+  for (const bool top : {true, false}) {
+    const double z = top ? height : 0;
+    const Vec3 normal{0, 0, top ? 1.0 : -1.0};
+    const uint32_t centre = builder.add_vertex({0, 0, z}, normal);
+    const uint32_t first = static_cast<uint32_t>(builder.vertex_count());
+    for (int r = 1; r <= subdivisions; ++r)
+      for (int i = 0; i < segments; ++i) {
+        const double phi = 2 * pi * i / segments, f = double(r) / subdivisions;
+        builder.add_vertex({f * a * std::cos(phi), f * b * std::sin(phi), z}, normal);
+      }
+    auto ring = [&](int r, int i) { return first + static_cast<uint32_t>((r - 1) * segments + (i % segments)); };
+    for (int i = 0; i < segments; ++i) {
+      if (top) builder.add_triangle(centre, ring(1, i), ring(1, i + 1));
+      else builder.add_triangle(centre, ring(1, i + 1), ring(1, i));
+      for (int r = 1; r < subdivisions; ++r) {
+        if (top) {
+          builder.add_triangle(ring(r, i), ring(r + 1, i), ring(r + 1, i + 1));
+          builder.add_triangle(ring(r, i), ring(r + 1, i + 1), ring(r, i + 1));
+        } else {
+          builder.add_triangle(ring(r, i), ring(r + 1, i + 1), ring(r + 1, i));
+          builder.add_triangle(ring(r, i), ring(r, i + 1), ring(r + 1, i + 1));
+        }
+      }
+    }
+  }
+  return builder.finish();
+}
+
 bool is_builtin_mesh_source(std::string_view source) { return source.substr(0, kBuiltinMeshPrefix.size()) == kBuiltinMeshPrefix; }
 
 std::optional<Mesh> make_builtin_mesh(std::string_view source) {
@@ -146,7 +216,24 @@ std::optional<Mesh> make_builtin_mesh(std::string_view source) {
   if (source == "builtin:pyramid") mesh = make_pyramid_mesh();
   if (source == "builtin:sphere") mesh = make_sphere_mesh();
   if (source == "builtin:cup") mesh = make_cup_mesh();
+  if (source == "builtin:box") mesh = make_box_mesh();
+  if (source == "builtin:cylinder") mesh = make_cylinder_mesh();
+  if (source == "builtin:plane") mesh = make_rectangle_mesh();
   if (mesh) mesh->source = std::string(source);  // messages about the mesh (a PRT bake's) name it
+  return mesh;
+}
+
+bool builtin_mesh_is_sized(std::string_view source) {
+  return source == "builtin:box" || source == "builtin:cylinder" || source == "builtin:plane";
+}
+
+std::optional<Mesh> make_builtin_mesh(std::string_view source, const Vec3& size_m) {
+  std::optional<Mesh> mesh;
+  if (source == "builtin:box") mesh = make_box_mesh(size_m);
+  else if (source == "builtin:cylinder") mesh = make_cylinder_mesh(size_m);
+  else if (source == "builtin:plane") mesh = make_rectangle_mesh(size_m[0], size_m[1]);
+  else return make_builtin_mesh(source);
+  mesh->source = std::string(source);
   return mesh;
 }
 

@@ -1,5 +1,5 @@
 // The procedural meshes a scene can name without a file ("builtin:cube", "builtin:pyramid",
-// "builtin:sphere", "builtin:cup"):
+// "builtin:sphere", "builtin:cup", "builtin:box", "builtin:cylinder", "builtin:plane"):
 // base on z = 0, centred on the object origin in x and y, about 6 cm across.
 #pragma once
 
@@ -22,13 +22,26 @@ Mesh make_cup_mesh(double outer_m = 0.06, double inner_m = 0.04, double height_m
                    int subdivisions = 8);
 // A square on z = 0 facing +z (the shadow catcher's ground patch).
 Mesh make_plane_mesh(double edge_m = 1.0, int subdivisions = 8);
+// A box of size x, y, z (metres), base on z = 0, flat faces: a proxy for a real carton or table.
+Mesh make_box_mesh(const Vec3& size_m = {0.06, 0.06, 0.06}, int subdivisions = 8);
+// A rectangle of size x, y on z = 0 facing +z.
+Mesh make_rectangle_mesh(double x_m = 0.06, double y_m = 0.06, int subdivisions = 8);
+// An upright cylinder, base on z = 0: diameters size x and y (an elliptic section when they
+// differ), height size z; smooth side normals, flat caps; `segments` around (at least 3).
+Mesh make_cylinder_mesh(const Vec3& size_m = {0.06, 0.06, 0.06}, int segments = 48, int subdivisions = 8);
 
 // How a scene names a builtin mesh instead of a file: "builtin:cube", "builtin:pyramid".
 inline constexpr std::string_view kBuiltinMeshPrefix = "builtin:";
 inline constexpr std::string_view kBuiltinMeshNames =
-    "\"builtin:cube\", \"builtin:pyramid\", \"builtin:sphere\", \"builtin:cup\"";
+    "\"builtin:cube\", \"builtin:pyramid\", \"builtin:sphere\", \"builtin:cup\", \"builtin:box\", "
+    "\"builtin:cylinder\", \"builtin:plane\"";
 bool is_builtin_mesh_source(std::string_view source);
 // The builtin mesh a source names, at its default size; nullopt for an unknown builtin name.
 std::optional<Mesh> make_builtin_mesh(std::string_view source);
+// The same, with "builtin:box", "builtin:cylinder" and "builtin:plane" made at size_m (x, y, z;
+// the plane ignores z); the other builtins ignore it.
+std::optional<Mesh> make_builtin_mesh(std::string_view source, const Vec3& size_m);
+// Whether a builtin takes its size from size_m.
+bool builtin_mesh_is_sized(std::string_view source);
 
 }  // namespace arpipe

@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <map>
+#include <optional>
 #include <utility>
 
 namespace arpipe {
@@ -77,6 +79,63 @@ TEST(BuiltinMeshes, PyramidHasItsBaseOnZZeroAndApexAbove) {
   EXPECT_EQ(pyramid.triangle_count(), 8u * 8 * 2 + 4u * 8 * 8);
   expect_outward_and_consistent(pyramid, {0, 0, 0.01});
   expect_closed(pyramid);
+}
+
+// The enclosed volume by the divergence theorem: sum over triangles of a . (b x c) / 6.
+double enclosed_volume(const Mesh& mesh) {
+  double volume = 0;
+  for (size_t t = 0; t < mesh.indices.size(); t += 3)
+    volume += dot(vertex(mesh, mesh.indices[t]), cross(vertex(mesh, mesh.indices[t + 1]), vertex(mesh, mesh.indices[t + 2])));
+  return volume / 6;
+}
+
+TEST(BuiltinMeshes, BoxHasItsSizeAndVolume) {
+  const Mesh box_mesh = make_box_mesh({0.10, 0.04, 0.07});
+  const Bounds box = box_mesh.bounds();
+  EXPECT_NEAR(box.min[0], -0.05, 1e-7);
+  EXPECT_NEAR(box.max[1], 0.02, 1e-7);
+  EXPECT_EQ(box.min[2], 0.0);
+  EXPECT_NEAR(box.max[2], 0.07, 1e-7);
+  EXPECT_NEAR(enclosed_volume(box_mesh), 0.10 * 0.04 * 0.07, 1e-9);
+  expect_outward_and_consistent(box_mesh, {0, 0, 0.035});
+  expect_closed(box_mesh);
+}
+
+// An elliptic cylinder of n segments encloses the inscribed polygon's area (n/2 sin(2 pi/n) a b)
+// times its height; its side normals are the ellipse's (x/a^2, y/b^2), not the radial direction.
+TEST(BuiltinMeshes, CylinderIsClosedWithTheEllipsesNormals) {
+  const double a = 0.04, b = 0.025, h = 0.09;
+  const int n = 48;
+  const Mesh cylinder = make_cylinder_mesh({2 * a, 2 * b, h}, n, 4);
+  const Bounds box = cylinder.bounds();
+  EXPECT_NEAR(box.max[0], a, 1e-7);
+  EXPECT_NEAR(box.max[1], b, 1e-4);  // the polygon's top vertex: n is a multiple of 4
+  EXPECT_EQ(box.min[2], 0.0);
+  EXPECT_NEAR(box.max[2], h, 1e-7);
+  const double polygon_area = 0.5 * n * std::sin(2 * 3.14159265358979323846 / n) * a * b;
+  EXPECT_NEAR(enclosed_volume(cylinder), polygon_area * h, 1e-9);
+  expect_closed(cylinder);
+  for (size_t v = 0; v < cylinder.vertex_count(); ++v) {
+    const Vec3 p = vertex(cylinder, static_cast<uint32_t>(v)), m = normal(cylinder, static_cast<uint32_t>(v));
+    if (std::abs(m[2]) > 0.5) continue;  // a cap's
+    const Vec3 expected = normalized(Vec3{p[0] / (a * a), p[1] / (b * b), 0});
+    EXPECT_NEAR(dot(m, expected), 1.0, 1e-6) << "vertex " << v;
+  }
+}
+
+TEST(BuiltinMeshes, SizedBuiltinsTakeTheirSizeAndOthersIgnoreIt) {
+  EXPECT_TRUE(builtin_mesh_is_sized("builtin:box"));
+  EXPECT_FALSE(builtin_mesh_is_sized("builtin:cube"));
+  const std::optional<Mesh> plane = make_builtin_mesh("builtin:plane", {0.3, 0.2, 5});
+  ASSERT_TRUE(plane);
+  EXPECT_NEAR(plane->bounds().max[0], 0.15, 1e-7);
+  EXPECT_NEAR(plane->bounds().max[1], 0.10, 1e-7);
+  EXPECT_EQ(plane->bounds().max[2], 0.0);
+  const std::optional<Mesh> cube = make_builtin_mesh("builtin:cube", {1, 1, 1});
+  ASSERT_TRUE(cube);
+  EXPECT_NEAR(cube->bounds().max[2], 0.06, 1e-7);
+  EXPECT_EQ(cube->source, "builtin:cube");
+  EXPECT_FALSE(make_builtin_mesh("builtin:nothing", {1, 1, 1}));
 }
 
 }  // namespace
