@@ -25,10 +25,12 @@ FrameRenderer::FrameRenderer(const CameraRayGrid& rays, int width, int height, i
       threads_(threads > 0 ? threads : int(std::clamp(std::thread::hardware_concurrency(), 1u, 64u))) {}
 
 void FrameRenderer::render(const SceneShader& shader, const ShutterPoseTable& poses, const FrameMetadata& meta,
-                           double trajectory_time_s, uint64_t frame_index, RadianceImage& out) const {
+                           double trajectory_time_s, uint64_t frame_index, RadianceImage& out,
+                           std::vector<float>* coverage) const {
   out.width = width_;
   out.height = height_;
   out.rgb.assign(size_t(width_) * height_ * 3, 0.0f);
+  if (coverage != nullptr) coverage->assign(size_t(width_) * height_, 0.0f);
   const double exposure_s = meta.exposure_ns * 1e-9;
   const int spp = samples_per_pixel_, n = samples_per_axis_;
 
@@ -44,6 +46,7 @@ void FrameRenderer::render(const SceneShader& shader, const ShutterPoseTable& po
         for (int i = 0; i < spp; ++i) time_stratum[size_t(i)] = i;
         for (int i = spp - 1; i > 0; --i) std::swap(time_stratum[size_t(i)], time_stratum[rng.next_u32() % uint32_t(i + 1)]);
         double sum[3] = {0, 0, 0};
+        int covered = 0;
         for (int i = 0; i < spp; ++i) {
           const double px = x - 0.5 + ((i % n) + rng.uniform()) / n;
           const double py = y - 0.5 + ((i / n) + rng.uniform()) / n;
@@ -55,10 +58,13 @@ void FrameRenderer::render(const SceneShader& shader, const ShutterPoseTable& po
           const Vec3 dir{R[0][0] * d[0] + R[0][1] * d[1] + R[0][2] * d[2],
                          R[1][0] * d[0] + R[1][1] * d[1] + R[1][2] * d[2],
                          R[2][0] * d[0] + R[2][1] * d[1] + R[2][2] * d[2]};
-          const Rgb radiance = shader.radiance({pose.centre[0], pose.centre[1], pose.centre[2]}, dir, rng);
+          bool virtual_hit = false;
+          const Rgb radiance = shader.radiance({pose.centre[0], pose.centre[1], pose.centre[2]}, dir, rng, virtual_hit);
+          covered += virtual_hit ? 1 : 0;
           for (int c = 0; c < 3; ++c) sum[c] += radiance[size_t(c)];
         }
         for (int c = 0; c < 3; ++c) out.rgb[pixel * 3 + size_t(c)] = float(sum[c] / spp);
+        if (coverage != nullptr) (*coverage)[pixel] = float(double(covered) / spp);
       }
     }
   };

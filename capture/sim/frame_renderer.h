@@ -30,9 +30,12 @@ class FrameRenderer {
   FrameRenderer(const CameraRayGrid& rays, int width, int height, int samples_per_pixel, uint64_t seed, int threads = 0);
 
   // poses: the camera over this frame's exposure window; trajectory_time_s: the trajectory's time
-  // at meta.exposure_start_ns.
+  // at meta.exposure_start_ns. coverage, when given, receives per pixel (row-major) the fraction
+  // of the pixel's samples whose first hit is a virtual object (the same samples as `out`; a
+  // sample outside what the lens sees counts as not covered).
   void render(const SceneShader& shader, const ShutterPoseTable& poses, const FrameMetadata& meta,
-              double trajectory_time_s, uint64_t frame_index, RadianceImage& out) const;
+              double trajectory_time_s, uint64_t frame_index, RadianceImage& out,
+              std::vector<float>* coverage = nullptr) const;
 
  private:
   const CameraRayGrid& rays_;

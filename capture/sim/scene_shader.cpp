@@ -148,7 +148,20 @@ struct SceneShader::Impl {
         Mesh mesh;
         try {
           if (!object.mesh_builtin.empty()) {
-            auto builtin = make_builtin_mesh(object.mesh_builtin);
+            if (object.mesh_size_m) {
+              const Vec3& size = *object.mesh_size_m;
+              const bool plane = object.mesh_builtin == "builtin:plane";
+              check_object(builtin_mesh_is_sized(object.mesh_builtin), object,
+                           fmt::format("\"{}\" has a fixed size; a size applies to \"builtin:box\", "
+                                       "\"builtin:cylinder\" and \"builtin:plane\"",
+                                       object.mesh_builtin));
+              check_object(std::isfinite(size[0]) && std::isfinite(size[1]) && std::isfinite(size[2]) &&
+                               size[0] > 0 && size[1] > 0 && (plane ? size[2] >= 0 : size[2] > 0),
+                           object, fmt::format("a mesh size must be finite and positive, got [{}, {}, {}] m", size[0],
+                                               size[1], size[2]));
+            }
+            auto builtin = object.mesh_size_m ? make_builtin_mesh(object.mesh_builtin, *object.mesh_size_m)
+                                              : make_builtin_mesh(object.mesh_builtin);
             if (!builtin) throw AssetError(fmt::format("unknown builtin mesh \"{}\" (expected {})", object.mesh_builtin,
                                                        kBuiltinMeshNames));
             mesh = std::move(*builtin);
@@ -317,8 +330,10 @@ struct SceneShader::Impl {
     return out;
   }
 
-  Rgb trace(const Vec3& origin, const Vec3& d, SampleRng& rng) const {
+  // first_hit_virtual, when given, says whether the first surface along the ray is a virtual object.
+  Rgb trace(const Vec3& origin, const Vec3& d, SampleRng& rng, bool* first_hit_virtual = nullptr) const {
     const ShapeHit hit = scene.intersect(origin, d);
+    if (first_hit_virtual != nullptr) *first_hit_virtual = hit.hit() && hit.shape < surfaces.size() && surfaces[hit.shape].is_virtual;
     if (!hit.hit()) return sky(d);
     const Surface& s = surfaces[hit.shape];
     if (s.kind == Surface::Kind::Light) return s.emitted;
@@ -353,6 +368,10 @@ SceneShader::~SceneShader() = default;
 
 Rgb SceneShader::radiance(const Vec3& origin, const Vec3& dir, SampleRng& rng) const {
   return impl_->trace(origin, normalized(dir), rng);
+}
+
+Rgb SceneShader::radiance(const Vec3& origin, const Vec3& dir, SampleRng& rng, bool& first_hit_virtual) const {
+  return impl_->trace(origin, normalized(dir), rng, &first_hit_virtual);
 }
 
 bool SceneShader::sees_virtual_object(const Vec3& origin, const Vec3& dir) const {

@@ -24,6 +24,9 @@ class SceneShader {
   // origin + t dir, t > 0. Draws its light-sampling random numbers (soft shadows, sphere lights,
   // the sky's ambient light) from rng only. Thread-safe (const): many threads call it at once.
   Rgb radiance(const Vec3& origin, const Vec3& dir, SampleRng& rng) const;
+  // The same radiance (the same random numbers drawn), also saying whether the first surface
+  // along the ray is a virtual object: what the ground-truth coverage counts.
+  Rgb radiance(const Vec3& origin, const Vec3& dir, SampleRng& rng, bool& first_hit_virtual) const;
   // Whether the first surface along the ray is a virtual object (never, without include_virtual).
   bool sees_virtual_object(const Vec3& origin, const Vec3& dir) const;
 

@@ -65,7 +65,11 @@ struct SimObject {
   double radius_m = 0;         // Sphere: centred on the local origin
   std::filesystem::path mesh_path;  // Mesh: glTF 2.0, loaded with core/scene/gltf_loader.h, or
   std::string mesh_builtin;         //   a builtin mesh ("builtin:cube": core/scene/builtin_meshes.h)
-  double mesh_scale = 1.0;          // Mesh: uniform scale applied in the object frame
+  // Mesh, the sized builtins ("builtin:box", "builtin:cylinder", "builtin:plane"; see
+  // builtin_mesh_is_sized): made at this size x, y, z in metres (the plane ignores z); nullopt:
+  // the builtin's default size.
+  std::optional<Vec3> mesh_size_m;
+  double mesh_scale = 1.0;          // Mesh: uniform scale applied in the object frame (after the size)
   SimMaterial material;
   bool is_virtual = false;  // left out of the camera frames, drawn only in the ground-truth composite
   bool casts_shadows = true;

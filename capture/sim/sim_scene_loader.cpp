@@ -428,6 +428,19 @@ void read_texture(const TomlSection& object, const TomlSection& s, SimObject& ou
   }
 }
 
+// A sized builtin's size_m = [x, y, z]: metres, finite, each in (0, kMaxMeshSizeM]; the plane
+// ignores z, which may then be 0.
+constexpr double kMaxMeshSizeM = 1000.0;
+
+Vec3 read_mesh_size(const TomlSection& s, std::string_view source) {
+  if (source != "builtin:plane") return s.vec3("size_m", {0, 0, 0}, NumberRange::open_closed(0, kMaxMeshSizeM).in("m"));
+  const Vec3 size = s.vec3("size_m", {0, 0, 0}, NumberRange::closed(0, kMaxMeshSizeM).in("m"));
+  if (size[0] == 0 || size[1] == 0)
+    s.fail("size_m", fmt::format("[x, y, z] with x and y in (0, {:g}] m (a plane ignores z)", kMaxMeshSizeM),
+           fmt::format("{} (a zero side)", show(size)));
+  return size;
+}
+
 SimObject read_object(const TomlSection& s, size_t index) {
   SimObject out;
   out.name = s.string("name", fmt::format("object{}", index));
@@ -448,7 +461,7 @@ SimObject read_object(const TomlSection& s, size_t index) {
 
   if (out.shape == SimObject::Shape::Plane) {
     only({"radius_m"}, "sphere");
-    only({"mesh", "mesh_scale"}, "mesh");
+    only({"mesh", "mesh_scale", "size_m"}, "mesh");
     const auto texture = s.section("texture");
     if (texture) read_texture(s, *texture, out);
     if (out.material.texture.kind == SimTexture::Kind::None || out.material.texture.kind == SimTexture::Kind::Image) {
@@ -457,7 +470,7 @@ SimObject read_object(const TomlSection& s, size_t index) {
     }
   } else if (out.shape == SimObject::Shape::Sphere) {
     only({"width_m", "height_m", "texture"}, "plane");
-    only({"mesh", "mesh_scale"}, "mesh");
+    only({"mesh", "mesh_scale", "size_m"}, "mesh");
     out.radius_m = s.number("radius_m", 0.05, kPositive);
   } else {
     only({"width_m", "height_m", "texture"}, "plane");
@@ -467,7 +480,17 @@ SimObject read_object(const TomlSection& s, size_t index) {
       if (!make_builtin_mesh(source))
         s.fail("mesh", fmt::format("one of {} or a glTF 2.0 file", kBuiltinMeshNames), toml_quoted(source));
       out.mesh_builtin = source;
+      if (s.has("size_m")) {
+        if (!builtin_mesh_is_sized(source))
+          s.fail_with("size_m", fmt::format("not allowed here: {} has a fixed size (scale it with mesh_scale); size_m "
+                                            "applies to \"builtin:box\", \"builtin:cylinder\" and \"builtin:plane\"",
+                                            toml_quoted(source)));
+        out.mesh_size_m = read_mesh_size(s, source);
+      }
     } else {
+      forbid(s, "size_m",
+             "a glTF mesh has its own size (scale it with mesh_scale); size_m applies to \"builtin:box\", "
+             "\"builtin:cylinder\" and \"builtin:plane\"");
       out.mesh_path = asset_file(s, "mesh", fmt::format("a glTF 2.0 file (.gltf or .glb) or one of {}", kBuiltinMeshNames));
       try {
         load_gltf_mesh(out.mesh_path);  // the simulator loads it again; this makes a bad file a scene error

@@ -16,6 +16,7 @@
 #include "capture/sim/camera_trajectory.h"
 #include "capture/sim/exposure_control.h"
 #include "capture/sim/frame_renderer.h"
+#include "capture/sim/ground_truth_coverage.h"
 #include "capture/sim/scene_shader.h"
 #include "capture/sim/sensor_model.h"
 #include "capture/sim/shutter_pose_table.h"
@@ -165,12 +166,17 @@ SimulateSummary simulate(const SimScene& scene, const SimulateOptions& options) 
   RecordingWriter writer(options.out_dir, RecordingInfo{kRecordingFormatVersion, camera.pixel_format, width, height, 0,
                                                         source, ""},
                          camera.model);
-  std::optional<RecordingWriter> composite_writer;
-  if (composite_world)
+  std::optional<RecordingWriter> composite_writer, coverage_writer;
+  if (composite_world) {
     composite_writer.emplace(options.out_dir / kGroundTruthCompositeDir,
                              RecordingInfo{kRecordingFormatVersion, PixelFormat::RGB24, width, height, 0,
                                            source + ": ground-truth composite", ""},
                              camera.model);
+    coverage_writer.emplace(options.out_dir / kGroundTruthCoverageDir,
+                            RecordingInfo{kRecordingFormatVersion, PixelFormat::GREY, width, height, 0,
+                                          source + ": ground-truth coverage of the virtual objects", ""},
+                            camera.model);
+  }
   if (!scene.source_file.empty() && fs::is_regular_file(scene.source_file)) {
     std::error_code ignored;  // a copy for reproducibility; the recording does not need it
     fs::copy_file(scene.source_file, options.out_dir / kSceneCopyFile, fs::copy_options::overwrite_existing, ignored);
@@ -180,6 +186,7 @@ SimulateSummary simulate(const SimScene& scene, const SimulateOptions& options) 
   const std::vector<GroundTruthLight> lights = ground_truth_lights(scene);
   ExposureControl exposure_control(camera);
   RadianceImage radiance, composite_radiance;
+  std::vector<float> coverage;
   for (int k = 0; k < frames; ++k) {
     const auto index = uint64_t(k);
     const ExposureSetting setting = exposure_control.setting(index);
@@ -197,16 +204,18 @@ SimulateSummary simulate(const SimScene& scene, const SimulateOptions& options) 
     writer.append(to_frame(expose(radiance, sensor, exposure, seed, index), width, height, camera.pixel_format, meta),
                   truth);
     if (composite_world) {
-      renderer.render(*composite_world, poses, meta, start_s, index, composite_radiance);
+      renderer.render(*composite_world, poses, meta, start_s, index, composite_radiance, &coverage);
       composite_writer->append(
           to_frame(expose(composite_radiance, sensor, exposure, seed, index), width, height, PixelFormat::RGB24, meta),
           truth);
+      coverage_writer->append(coverage_frame(coverage, width, height, meta), truth);
     }
     exposure_control.update(mean_linear_value(radiance, sensor, exposure));
     if (options.on_frame) options.on_frame(k + 1, frames);
   }
   writer.flush();
   if (composite_writer) composite_writer->flush();
+  if (coverage_writer) coverage_writer->flush();
 
   SimulateSummary summary;
   summary.frames = frames;

@@ -1,5 +1,6 @@
 // `arpipe simulate`: renders a scene into a format-v1 recording with its ground truth, plus the
-// ground-truth composite when the scene has virtual objects (docs/SIMULATOR.md).
+// ground-truth composite and the virtual objects' coverage when the scene has virtual objects
+// (docs/SIMULATOR.md).
 #pragma once
 
 #include <cstdint>
@@ -17,7 +18,8 @@ namespace arpipe::sim {
 inline constexpr int64_t kMaxFrameSide = 8192;
 inline constexpr int64_t kMaxFramePixels = int64_t{1} << 24;
 
-// The ground-truth composite's recording, inside the output directory.
+// The ground-truth composite's recording, inside the output directory; beside it the coverage of
+// the virtual objects, kGroundTruthCoverageDir (capture/sim/ground_truth_coverage.h).
 inline constexpr const char* kGroundTruthCompositeDir = "ground_truth_composite";
 // The scene file as simulated, copied into the output directory.
 inline constexpr const char* kSceneCopyFile = "scene.toml";
@@ -36,7 +38,7 @@ struct SimulateSummary {
   int frames = 0;
   double seconds = 0;          // wall time in all
   double setup_seconds = 0;    // of which loading assets, building the Embree scenes and the ray grid
-  bool wrote_composite = false;
+  bool wrote_composite = false;  // and the coverage beside it
 };
 
 // Throws AssetError (a scene asset), RecordingError (writing), std::invalid_argument (options, or a
