@@ -8,6 +8,7 @@ find_package(ZLIB REQUIRED)
 find_package(PNG REQUIRED)  # simulator textures: PNG decoded by libpng, not by OpenCV's format probing
 find_package(embree 3 REQUIRED)  # target: embree (the simulator's ray caster)
 find_package(fmt REQUIRED)
+find_package(meshoptimizer REQUIRED)  # target: meshoptimizer::meshoptimizer (proxy simplification)
 pkg_check_modules(TOMLPP REQUIRED IMPORTED_TARGET tomlplusplus)
 pkg_check_modules(SYSTEMD REQUIRED IMPORTED_TARGET libsystemd)
 pkg_check_modules(EGL REQUIRED IMPORTED_TARGET egl)

@@ -12,6 +12,7 @@ packages=(
   libtomlplusplus-dev nlohmann-json3-dev libsystemd-dev libfmt-dev
   libgeographiclib-dev
   libbullet-dev  # rigid-body physics against the proxies (core/physics)
+  libmeshoptimizer-dev  # proxy simplification (arpipe proxy simplify, core/scene/mesh_simplify)
   # the command lines of arpipe and arpiped (header-only)
   libcli11-dev
   # HDR light probes (OpenEXR) and the PRT cache's content key (xxHash)

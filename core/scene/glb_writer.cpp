@@ -1,0 +1,190 @@
+// A Mesh as a binary glTF 2.0 file (.glb) in memory: what `arpipe proxy simplify` writes, and what
+// load_gltf_mesh (gltf_loader.h) reads back to the same triangles, positions and colours.
+#include "core/scene/glb_writer.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+#include <string>
+
+namespace arpipe {
+namespace {
+
+static_assert(std::endian::native == std::endian::little, "the .glb's binary chunk is written as the host stores it");
+
+constexpr uint32_t kGlbWriterMagic = 0x46546C67;      // "glTF"
+constexpr uint32_t kGlbWriterJsonChunk = 0x4E4F534A;  // "JSON"
+constexpr uint32_t kGlbWriterBinChunk = 0x004E4942;   // "BIN\0"
+constexpr int kGltfFloat = 5126, kGltfUnsignedInt = 5125;
+constexpr int kGltfArrayBuffer = 34962, kGltfElementArrayBuffer = 34963;
+
+// The BIN chunk as it grows, and the bufferViews and accessors that describe it.
+class GlbBinaryBuilder {
+ public:
+  // A tightly packed bufferView of `bytes`, 4-byte aligned; its index.
+  size_t add_view(const void* bytes, size_t size, int target) {
+    const size_t offset = bin_.size();
+    bin_.resize(offset + size);
+    if (size > 0) std::memcpy(bin_.data() + offset, bytes, size);
+    bin_.resize((bin_.size() + 3) / 4 * 4, 0);
+    views_.push_back({{"buffer", 0}, {"byteOffset", offset}, {"byteLength", size}, {"target", target}});
+    return views_.size() - 1;
+  }
+  size_t add_accessor(nlohmann::json accessor) {
+    accessors_.push_back(std::move(accessor));
+    return accessors_.size() - 1;
+  }
+  // float3 per vertex in glTF's axes; POSITION accessors carry min and max (the spec asks for them).
+  size_t add_vec3_accessor(const std::vector<float>& xyz, bool with_bounds) {
+    const size_t count = xyz.size() / 3;
+    nlohmann::json accessor = {{"bufferView", add_view(xyz.data(), xyz.size() * sizeof(float), kGltfArrayBuffer)},
+                               {"componentType", kGltfFloat},
+                               {"count", count},
+                               {"type", "VEC3"}};
+    if (with_bounds) {
+      std::array<float, 3> low{}, high{};
+      for (size_t axis = 0; axis < 3; ++axis) {
+        low[axis] = high[axis] = xyz[axis];
+        for (size_t i = axis; i < xyz.size(); i += 3) {
+          low[axis] = std::min(low[axis], xyz[i]);
+          high[axis] = std::max(high[axis], xyz[i]);
+        }
+      }
+      accessor["min"] = low;
+      accessor["max"] = high;
+    }
+    return add_accessor(std::move(accessor));
+  }
+  const std::vector<uint8_t>& bin() const { return bin_; }
+  nlohmann::json& views() { return views_; }
+  nlohmann::json& accessors() { return accessors_; }
+
+ private:
+  std::vector<uint8_t> bin_;
+  nlohmann::json views_ = nlohmann::json::array();
+  nlohmann::json accessors_ = nlohmann::json::array();
+};
+
+void check_encodable(const Mesh& mesh) {
+  const std::string name = mesh.source.empty() ? std::string("the mesh") : mesh.source;
+  auto fail = [&](const std::string& what) { throw std::invalid_argument(fmt::format("{}: {}", name, what)); };
+  if (mesh.positions.size() % 3 != 0 || mesh.indices.size() % 3 != 0 || mesh.indices.empty())
+    fail(fmt::format("not a triangle mesh ({} position floats, {} indices)", mesh.positions.size(), mesh.indices.size()));
+  if (!mesh.normals.empty() && mesh.normals.size() != mesh.positions.size())
+    fail(fmt::format("{} normal floats for {} position floats", mesh.normals.size(), mesh.positions.size()));
+  for (const std::vector<float>* values : {&mesh.positions, &mesh.normals})
+    for (size_t i = 0; i < values->size(); ++i)
+      if (!std::isfinite((*values)[i]))
+        fail(fmt::format("vertex {} has a {} that is not finite", i / 3, values == &mesh.positions ? "position" : "normal"));
+  for (size_t i = 0; i < mesh.indices.size(); ++i)
+    if (mesh.indices[i] >= mesh.vertex_count())
+      fail(fmt::format("index {} is {}, past the last vertex ({} vertices)", i, mesh.indices[i], mesh.vertex_count()));
+  for (size_t p = 0; p < mesh.parts.size(); ++p)
+    if (mesh.parts[p].first_index % 3 != 0 || mesh.parts[p].index_count % 3 != 0 ||
+        uint64_t{mesh.parts[p].first_index} + mesh.parts[p].index_count > mesh.indices.size())
+      fail(fmt::format("part {} is not whole triangles of the {} indices", p, mesh.indices.size()));
+  for (const MeshPart& part : mesh.parts)
+    for (float c : part.base_color)
+      if (!std::isfinite(c)) fail("a part's base colour is not finite");
+}
+
+void append_u32(std::vector<uint8_t>& out, uint32_t value) {
+  for (int i = 0; i < 4; ++i) out.push_back(static_cast<uint8_t>(value >> (8 * i)));
+}
+
+}  // namespace
+
+std::vector<uint8_t> encode_glb(const Mesh& mesh, std::string_view generator) {
+  check_encodable(mesh);
+  std::vector<MeshPart> parts = mesh.parts;
+  if (parts.empty()) parts.push_back(MeshPart{0, static_cast<uint32_t>(mesh.indices.size()), {1, 1, 1, 1}});
+
+  GlbBinaryBuilder builder;
+  nlohmann::json materials = nlohmann::json::array(), primitives = nlohmann::json::array();
+  std::vector<std::array<float, 4>> colours;
+  std::vector<uint32_t> local(mesh.vertex_count());
+  std::vector<bool> seen(mesh.vertex_count());
+  for (const MeshPart& part : parts) {
+    if (part.index_count == 0) continue;
+    // The part's own vertices, in the order its triangles first use them, in glTF's axes.
+    std::fill(seen.begin(), seen.end(), false);
+    std::vector<float> positions, normals;
+    std::vector<uint32_t> indices;
+    indices.reserve(part.index_count);
+    for (uint32_t i = part.first_index; i < part.first_index + part.index_count; ++i) {
+      const uint32_t v = mesh.indices[i];
+      if (!seen[v]) {
+        seen[v] = true;
+        local[v] = static_cast<uint32_t>(positions.size() / 3);
+        const float* p = &mesh.positions[3 * size_t{v}];
+        positions.insert(positions.end(), {p[0], p[2], -p[1]});
+        if (!mesh.normals.empty()) {
+          const float* n = &mesh.normals[3 * size_t{v}];
+          normals.insert(normals.end(), {n[0], n[2], -n[1]});
+        }
+      }
+      indices.push_back(local[v]);
+    }
+    nlohmann::json attributes = {{"POSITION", builder.add_vec3_accessor(positions, true)}};
+    if (!normals.empty()) attributes["NORMAL"] = builder.add_vec3_accessor(normals, false);
+    const size_t index_view =
+        builder.add_view(indices.data(), indices.size() * sizeof(uint32_t), kGltfElementArrayBuffer);
+    const size_t index_accessor = builder.add_accessor(
+        {{"bufferView", index_view}, {"componentType", kGltfUnsignedInt}, {"count", indices.size()}, {"type", "SCALAR"}});
+
+    auto colour = std::find(colours.begin(), colours.end(), part.base_color);
+    if (colour == colours.end()) {
+      colours.push_back(part.base_color);
+      colour = colours.end() - 1;
+      materials.push_back({{"name", fmt::format("colour {}", colours.size() - 1)},
+                           {"pbrMetallicRoughness",
+                            {{"baseColorFactor", part.base_color}, {"metallicFactor", 0.0}, {"roughnessFactor", 1.0}}}});
+    }
+    primitives.push_back({{"attributes", std::move(attributes)},
+                          {"indices", index_accessor},
+                          {"material", colour - colours.begin()},
+                          {"mode", 4}});
+  }
+
+  const std::vector<uint8_t>& bin = builder.bin();
+  using nlohmann::json;
+  json node = {{"mesh", 0}};
+  if (!mesh.source.empty()) node["name"] = mesh.source;
+  json document = json::object();
+  document["asset"] = {{"version", "2.0"}, {"generator", std::string(generator)}};
+  document["scene"] = 0;
+  document["scenes"] = json::array({json{{"nodes", json::array({0})}}});
+  document["nodes"] = json::array({std::move(node)});
+  document["meshes"] = json::array({json{{"primitives", std::move(primitives)}}});
+  document["materials"] = std::move(materials);
+  document["accessors"] = std::move(builder.accessors());
+  document["bufferViews"] = std::move(builder.views());
+  document["buffers"] = json::array({json{{"byteLength", bin.size()}}});
+  std::string json_text = document.dump();
+  json_text.resize((json_text.size() + 3) / 4 * 4, ' ');
+
+  const uint64_t total = 12 + 8 + uint64_t{json_text.size()} + 8 + uint64_t{bin.size()};
+  if (total > std::numeric_limits<uint32_t>::max())
+    throw std::invalid_argument(
+        fmt::format("{}: {} bytes, over the 4 GiB a .glb can hold", mesh.source.empty() ? "the mesh" : mesh.source, total));
+  std::vector<uint8_t> out;
+  out.reserve(static_cast<size_t>(total));
+  append_u32(out, kGlbWriterMagic);
+  append_u32(out, 2);
+  append_u32(out, static_cast<uint32_t>(total));
+  append_u32(out, static_cast<uint32_t>(json_text.size()));
+  append_u32(out, kGlbWriterJsonChunk);
+  out.insert(out.end(), json_text.begin(), json_text.end());
+  append_u32(out, static_cast<uint32_t>(bin.size()));
+  append_u32(out, kGlbWriterBinChunk);
+  out.insert(out.end(), bin.begin(), bin.end());
+  return out;
+}
+
+}  // namespace arpipe
