@@ -59,8 +59,10 @@ uniform float u_specular;        // its weight
 uniform vec3 u_camera_world;     // the eye, for the reflection direction
 uniform float u_exposure_scale;
 uniform bool u_shadow_catcher;
+uniform bool u_proxy;            // real geometry: depth only, or the catcher's darkening
 out vec4 out_color;              // linear, premultiplied alpha
 {shadow_lookup}
+{real_shadow_lookup}
 vec3 sh9_at(vec3 c[9], vec3 n) {{
   return 0.282095 * c[0] + 0.488603 * (n.y * c[1] + n.z * c[2] + n.x * c[3])
        + 1.092548 * (n.x * n.y * c[4] + n.y * n.z * c[5] + n.x * n.z * c[7])
@@ -76,13 +78,19 @@ void main() {{
   float lambert = max(dot(normal, towards_light), 0.0);
   float visibility = shadow_visibility(v_world);  // uniform control flow: it takes derivatives
   if (u_shadow_catcher) {{
-    // Differential rendering: the real ground's light with the virtual shadow over its light
-    // without it. One ratio for all channels (the layer has one alpha), by luminance.
+    // Differential rendering: the real surface's light with the virtual shadow over its light
+    // without it, where the real casters already shade it as they do in the picture. One ratio
+    // for all channels (the layer has one alpha), by luminance.
     const vec3 luma = vec3(0.2126, 0.7152, 0.0722);
     float ambient = max(dot(ambient_at(normal), luma), 0.0);
     float direct = dot(u_light_color, luma) * lambert;
-    float ratio = ambient + direct > 0.0 ? (ambient + visibility * direct) / (ambient + direct) : 1.0;
+    float real_direct = direct * real_shadow_visibility(v_world);
+    float ratio = ambient + real_direct > 0.0 ? min((ambient + visibility * direct) / (ambient + real_direct), 1.0) : 1.0;
     out_color = vec4(0.0, 0.0, 0.0, 1.0 - ratio);
+    return;
+  }}
+  if (u_proxy) {{
+    out_color = vec4(0.0);
     return;
   }}
   vec3 environment = u_prt ? v_prt_radiance : ambient_at(normal);
@@ -184,7 +192,8 @@ const GlProgram& ObjectRenderer::shading(ShadowMethod method) {
   auto found = shading_.find(method);
   if (found == shading_.end()) {
     const std::string fragment = fmt::format(fmt::runtime(kShadingFragmentShaderTemplate),
-                                             fmt::arg("shadow_lookup", shadow_lookup_glsl(method)));
+                                             fmt::arg("shadow_lookup", shadow_lookup_glsl(method)),
+                                             fmt::arg("real_shadow_lookup", real_shadow_lookup_glsl()));
     found = shading_
                 .emplace(method, GlProgram(fmt::format("object shading ({} shadows)", shadow_method_name(method)),
                                            vertex_source({"pose"}, kShadingVertexShader), fragment))
@@ -214,11 +223,13 @@ void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, c
   glUniform3fv(program.uniform("u_radiance_sh"), 9, sh.data());
   glUniform1f(program.uniform("u_exposure_scale"), static_cast<float>(lighting.exposure_scale));
   if (lighting.shadow) set_shadow_lookup_uniforms(program, *lighting.shadow, 1);
+  set_real_shadow_uniforms(program, lighting.shadow ? lighting.real_shadow : nullptr, 2);
   const GLint world_from_object_rotation = program.uniform("u_world_from_object_rotation");
   const GLint world_from_object_translation = program.uniform("u_world_from_object_translation");
   const GLint object_scale = program.uniform("u_object_scale");
   const GLint base_color = program.uniform("u_base_color");
   const GLint shadow_catcher = program.uniform("u_shadow_catcher");
+  const GLint proxy = program.uniform("u_proxy");
   const GLint prt = program.uniform("u_prt");
   const GLint specular = program.uniform("u_specular");
   const GLint camera_world = program.uniform("u_camera_world");
@@ -230,13 +241,15 @@ void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, c
     set_vec3(world_from_object_translation, item.object->T_world_object.translation());
     glUniform1f(object_scale, static_cast<float>(item.object->scale));
     glUniform1i(shadow_catcher, item.object->shadow_catcher ? 1 : 0);
-    glUniform1f(specular, item.object->shadow_catcher ? 0.0f : static_cast<float>(item.object->specular));
+    glUniform1i(proxy, item.object->proxy ? 1 : 0);
+    glDepthMask(item.object->writes_depth ? GL_TRUE : GL_FALSE);
+    glUniform1f(specular, item.object->shadow_catcher || item.object->proxy ? 0.0f : static_cast<float>(item.object->specular));
     if (item.object->specular > 0 && !item.poses.T_cam_object.empty()) {
       // The eye of the middle row: rows differ by far less than the reflection's blur.
       const SE3& T_cam_object = item.poses.T_cam_object[item.poses.T_cam_object.size() / 2];
       set_vec3(camera_world, item.object->T_world_object * T_cam_object.inverse().translation());
     }
-    const bool use_prt = item.object->mesh->has_transfer() && !item.object->shadow_catcher;
+    const bool use_prt = item.object->mesh->has_transfer() && !item.object->shadow_catcher && !item.object->proxy;
     glUniform1i(prt, use_prt ? 1 : 0);
     if (use_prt) {
       // The transfer lives in the object's frame: turn the world's light into it.
@@ -248,6 +261,7 @@ void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, c
       glUniform4f(base_color, color[0], color[1], color[2], color[3]);
     });
   }
+  glDepthMask(GL_TRUE);
 }
 
 void ObjectRenderer::draw_velocity(const LensUniforms& lens, const RowProjection& rows,

@@ -31,6 +31,9 @@ struct Lighting {
   std::array<Vec3, 9> radiance_sh{};  // the ambient light as radiance SH (world), for PRT
   double exposure_scale = 1;
   const ShadowLookup* shadow = nullptr;  // nullptr: nothing is shadowed
+  // The real casters' own map (proxies with cast_shadows); nullptr: none. The catcher's ratio is
+  // (ambient + visibility * direct) / (ambient + real visibility * direct).
+  const ShadowLookup* real_shadow = nullptr;
 };
 
 struct ObjectAtInstant {
@@ -54,7 +57,10 @@ class ObjectRenderer {
   // scissor as set by the caller), with the lens as the projection. A shadow catcher
   // (UploadedObject::shadow_catcher) draws no colour: its alpha is 1 - the ratio by which the
   // virtual objects' shadow darkens the real ground, (ambient + visibility * direct) /
-  // (ambient + direct) in luminance, so the composite multiplies the camera frame by that ratio.
+  // (ambient + real visibility * direct) in luminance, so the composite multiplies the camera
+  // frame by that ratio. Any other proxy draws (0, 0, 0, 0): only its depth, so the camera shows.
+  // A proxy that hides nothing (UploadedObject::writes_depth false) leaves the depth alone; the
+  // caller draws those first.
   void draw(const LensUniforms& lens, const RowProjection& rows, const Lighting& lighting,
             std::span<const ObjectAtInstant> objects);
   // rg = end minus start image position (pixels of the lens image), b = depth at mid-exposure (m),

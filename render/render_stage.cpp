@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <numbers>
@@ -46,6 +47,8 @@ RenderStage::RenderStage(std::shared_ptr<RenderSession> session) : session_(std:
 RenderStage::~RenderStage() {
   session_->try_make_current();
   objects_.clear();
+  proxies_.clear();
+  real_shadow_pass_.reset();
   warp_pass_.reset();
   shadow_pass_.reset();
   receiver_.reset();
@@ -70,6 +73,9 @@ void RenderStage::configure_loaded(const Config& config, const std::shared_ptr<c
   if (!drawer_) drawer_ = std::make_unique<MotionBlurDrawer>(session_->context(), session_->layer().color_format());
   drawer_->prepare(config.render.blur.method);
   std::vector<UploadedObject> objects = upload_objects(config, loaded->meshes);
+  std::vector<UploadedObject> proxies = upload_proxies(config, loaded->meshes);
+  auto physics = std::make_unique<ScenePhysics>(config, loaded->meshes);
+  if (physics->empty()) physics.reset();
 
   Settings settings;
   settings.enabled = config.render.enabled;
@@ -85,6 +91,7 @@ void RenderStage::configure_loaded(const Config& config, const std::shared_ptr<c
   settings.max_predicted_uncertainty_deg = config.render.max_predicted_uncertainty_deg;
   settings.reuse_layer = config.render.reuse_layer;
   settings.full_canvas = config.render.full_canvas;
+  settings.default_exposure_ns = config.motion.default_exposure_ns;
   settings.blur = config.render.blur;
   settings.shadows = config.render.shadows;
   settings.shadow_method = config.render.shadows.method;
@@ -95,12 +102,22 @@ void RenderStage::configure_loaded(const Config& config, const std::shared_ptr<c
     shadow_pass_ = std::make_unique<ShadowMapPass>(session_->context(), settings.shadows);
   }
   if (!receiver_) receiver_ = std::make_unique<ShadowReceiver>();
+  // The real casters' map: a depth map for the catcher's real visibility (shadow_lookup_glsl.h).
+  const bool real_casters = std::any_of(proxies.begin(), proxies.end(), [](const UploadedObject& p) { return p.casts_shadows; });
+  ShadowConfig real_shadow_config = settings.shadows;
+  real_shadow_config.method = ShadowMethod::Pcf;
+  real_shadow_config.pcf_kernel = 3;
+  if (settings.shadow_method == ShadowMethod::Off || !real_casters) real_shadow_pass_.reset();
+  else if (!real_shadow_pass_ || real_shadow_pass_->config() != real_shadow_config)
+    real_shadow_pass_ = std::make_unique<ShadowMapPass>(session_->context(), real_shadow_config);
 
   // The warp's shader is compiled here rather than on the first frame that needs it.
   if (settings.lens == LensMode::Map && !warp_pass_)
     warp_pass_ = std::make_unique<LensWarpPass>(session_->layer().color_format());
 
   objects_ = std::move(objects);
+  proxies_ = std::move(proxies);
+  physics_ = std::move(physics);
   reuse_.forget();  // new objects or settings: draw again
   if (settings.lens_canvas_scale != settings_.lens_canvas_scale) warp_maps_.clear();
   settings_ = settings;
@@ -189,29 +206,65 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
       settings_.lens == LensMode::Undistort ? pinhole_core(ctx.camera_model) : nullptr;
   const CameraModel& image_camera = core ? *core : camera;
 
+  // The frame's motion. Objects that move themselves blur even when the camera's motion is not
+  // known: the camera then counts as still over the exposure.
+  ShutterMotion motion = ctx.motion;
+  if (physics_ && !motion.valid()) {
+    motion.state = MotionState::Extrapolated;
+    motion.timing = shutter_timing(ctx.camera.meta, camera.height(), settings_.default_exposure_ns);
+    motion.pose_time_ns = motion.timing.mid_ns();
+    motion.T_cam_world_start = motion.T_cam_world_mid = motion.T_cam_world_end = ctx.pose.T_cam_world;
+    motion.max_image_motion_px = 0;
+  }
+  if (physics_ && move_objects(motion)) reuse_.forget();
+
   // The rectangle the objects can reach over the exposure (blurred, or skewed by a rolling
   // shutter): their boxes at 9 instants from its start to its end, so that a path whose ends lie
   // outside the picture still counts where it crosses it (the margin covers the bend between).
-  std::vector<SE3> exposure_poses{ctx.pose.T_cam_world};
-  if (ctx.motion.valid()) {
-    const int64_t start = ctx.motion.timing.exposure_start_ns, span = ctx.motion.timing.end_ns() - start;
-    for (int k = 0; k <= kExposureInstants; ++k)
-      exposure_poses.push_back(ctx.motion.T_cam_world_at(start + span * k / kExposureInstants));
+  struct Instant {
+    SE3 T_cam_world;
+    int64_t t_ns;
+  };
+  std::vector<Instant> instants{{ctx.pose.T_cam_world, ctx.camera.meta.exposure_mid_ns()}};
+  if (motion.valid()) {
+    const int64_t start = motion.timing.exposure_start_ns, span = motion.timing.end_ns() - start;
+    for (int k = 0; k <= kExposureInstants; ++k) {
+      const int64_t t = start + span * k / kExposureInstants;
+      instants.push_back({motion.T_cam_world_at(t), t});
+    }
   }
-  LayerDrawRequest request;
-  PixelRect rect;  // in the output image
-  for (const UploadedObject& object : objects_) {
+  std::vector<SE3> exposure_poses;
+  for (const Instant& instant : instants) exposure_poses.push_back(instant.T_cam_world);
+  const auto rect_of = [&](const UploadedObject& object, PixelRect& into) {
     bool in_view = false;
-    for (const SE3& T_cam_world : exposure_poses) {
-      if (std::optional<PixelRect> object_rect =
-              projected_box_rect(image_camera, T_cam_world * object.T_world_object, object.bounds, kRectMarginPx)) {
-        rect = rect.united(*object_rect);
+    for (const Instant& instant : instants) {
+      const SE3 T_world_object = object.pose_at ? object.pose_at(instant.t_ns) : object.T_world_object;
+      if (std::optional<PixelRect> r =
+              projected_box_rect(image_camera, instant.T_cam_world * T_world_object, object.bounds, kRectMarginPx)) {
+        into = into.united(*r);
         in_view = true;
       }
     }
-    if (in_view) request.objects.push_back(&object);
-  }
+    return in_view;
+  };
+  LayerDrawRequest request;
+  PixelRect rect;  // in the output image
+  for (const UploadedObject& object : objects_)
+    if (object.present && rect_of(object, rect)) request.objects.push_back(&object);
   if (request.objects.empty()) return Drawn::OutOfView;
+  // Proxies in view: those that receive shadows but hide nothing go first, without depth, so
+  // that the objects cover them; those that hide go after the objects.
+  std::vector<const UploadedObject*> receivers_first, occluders;
+  PixelRect proxy_receivers;
+  for (const UploadedObject& proxy : proxies_) {
+    if (!proxy.writes_depth && !proxy.shadow_catcher) continue;  // neither hides nor catches: not drawn
+    PixelRect r;
+    if (!rect_of(proxy, r)) continue;
+    if (proxy.shadow_catcher) proxy_receivers = proxy_receivers.united(r);
+    (proxy.writes_depth ? occluders : receivers_first).push_back(&proxy);
+  }
+  request.objects.insert(request.objects.begin(), receivers_first.begin(), receivers_first.end());
+  request.objects.insert(request.objects.end(), occluders.begin(), occluders.end());
   session_->make_current();
 
   // "map": draw on the pinhole canvas, in the part of it that the output rectangle samples.
@@ -221,7 +274,7 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
     if (warp->identity()) warp.reset();  // a pinhole lens: the canvas is the image
   }
   const CameraModel& canvas_camera = warp ? warp->canvas().model() : image_camera;
-  request.motion = &ctx.motion;
+  request.motion = &motion;
   request.T_cam_world = ctx.pose.T_cam_world;
   request.lens = lens_uniforms(canvas_camera);
   request.canvas_camera = &canvas_camera;
@@ -231,7 +284,9 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
   bool shadow_redrawn = false;
   request.lighting.shadow = shadow_for(ctx, request.lighting, angular_diameter_rad, request.objects, shadow_redrawn);
   if (request.lighting.shadow) {
-    // The catcher's patch joins the footprint where it is in view.
+    // Proxies that catch the shadow join the footprint (their whole box: the shadow's place on
+    // them is not known here), and so does the ground catcher's patch.
+    rect = rect.united(proxy_receivers);
     const UploadedObject& catcher = *request.objects.back();
     for (const SE3& T_cam_world : exposure_poses)
       if (std::optional<PixelRect> r =
@@ -240,7 +295,7 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
   }
   if (settings_.full_canvas) rect = PixelRect::full(camera.width(), camera.height());
   request.rect = warp ? warp->canvas_rect_for(rect) : rect;
-  request.image_motion_px = ctx.motion.valid() ? ctx.motion.max_image_motion_px : 0;
+  request.image_motion_px = motion.valid() ? std::max(motion.max_image_motion_px, moving_objects_motion_px(motion, image_camera)) : 0;
   request.msaa_samples = settings_.msaa_samples;
   request.rolling_shutter = settings_.rolling_shutter;
 
@@ -318,7 +373,7 @@ Lighting RenderStage::frame_lighting(const FrameContext& ctx, double& angular_di
   return lighting;
 }
 
-const ShadowLookup* RenderStage::shadow_for(FrameContext& ctx, const Lighting& lighting, double angular_diameter_rad,
+const ShadowLookup* RenderStage::shadow_for(FrameContext& ctx, Lighting& lighting, double angular_diameter_rad,
                                             std::vector<const UploadedObject*>& drawn, bool& redrawn) {
   const auto start = std::chrono::steady_clock::now();
   const auto skip = [&](std::string why) -> const ShadowLookup* {
@@ -332,11 +387,20 @@ const ShadowLookup* RenderStage::shadow_for(FrameContext& ctx, const Lighting& l
   std::vector<ShadowCaster> casters;
   std::vector<const UploadedObject*> caster_objects;
   double extent = 0;
-  for (const UploadedObject& object : objects_) {
+  // The virtual objects and the proxies that cast: the real ones shadow the virtual ones.
+  std::vector<const UploadedObject*> real_casters;
+  const auto add_caster = [&](const UploadedObject& object) {
     casters.push_back({object.bounds, object.T_world_object});
     caster_objects.push_back(&object);
     extent = std::max(extent, norm(object.bounds.max - object.bounds.min));
-  }
+  };
+  for (const UploadedObject& object : objects_)
+    if (object.present) add_caster(object);
+  for (const UploadedObject& proxy : proxies_)
+    if (proxy.casts_shadows) {
+      add_caster(proxy);
+      real_casters.push_back(&proxy);
+    }
   // The penumbra of the tallest object, and a little more for the filters' reach.
   const double margin = extent * (std::tan(angular_diameter_rad) + 0.05);
   const std::optional<ShadowFrustum> frustum =
@@ -348,12 +412,67 @@ const ShadowLookup* RenderStage::shadow_for(FrameContext& ctx, const Lighting& l
   // Variance maps also hold the ground, so that filtering across an object's edge blends its depth
   // with the ground's rather than with empty space.
   if (is_variance_method(settings_.shadow_method)) caster_objects.push_back(&catcher);
-  const bool drew = shadow_pass_->render(*frustum, caster_objects, angular_diameter_rad);
+  bool drew = shadow_pass_->render(*frustum, caster_objects, angular_diameter_rad);
+  lighting.real_shadow = nullptr;
+  if (real_shadow_pass_ && !real_casters.empty()) {
+    drew = real_shadow_pass_->render(*frustum, real_casters, angular_diameter_rad) || drew;
+    lighting.real_shadow = &real_shadow_pass_->lookup();
+  }
   drawn.push_back(&catcher);
   redrawn = drew;
   if (drew) glFinish();  // honest timings: the work is queued until something waits
   ctx.record_timing("shadow", milliseconds_since(start), drew ? "" : "reused");
   return &shadow_pass_->lookup();
+}
+
+}  // namespace arpipe
+
+namespace arpipe {
+
+bool RenderStage::move_objects(const ShutterMotion& motion) {
+  const int64_t start = motion.timing.exposure_start_ns, end = motion.timing.end_ns();
+  physics_->advance(start, end);
+  bool moved = false;
+  const ScenePhysics* physics = physics_.get();
+  for (size_t i = 0; i < objects_.size(); ++i) {
+    const std::optional<BodySample> mid = physics->sample(i, start + (end - start) / 2);
+    if (!mid) continue;
+    UploadedObject& object = objects_[i];
+    moved = moved || !(mid->T_world_body.translation() == object.T_world_object.translation() &&
+                       mid->T_world_body.rotation() == object.T_world_object.rotation()) ||
+            mid->present != object.present;
+    object.T_world_object = mid->T_world_body;
+    object.present = mid->present;
+    object.pose_at = [physics, i](int64_t t) {
+      const std::optional<BodySample> sample = physics->sample(i, t);
+      return sample ? sample->T_world_body : SE3::identity();
+    };
+  }
+  return moved;
+}
+
+double RenderStage::moving_objects_motion_px(const ShutterMotion& motion, const CameraModel& camera) const {
+  // The length of each box corner's image path over the exposure, in kExposureInstants pieces: a
+  // ball that bounces within the exposure travels far though it ends near where it started.
+  double most = 0;
+  const int64_t start = motion.timing.exposure_start_ns, span = motion.timing.end_ns() - start;
+  for (const UploadedObject& object : objects_) {
+    if (!object.pose_at || !object.present) continue;
+    std::array<double, 8> length{};
+    std::array<std::optional<Vec2>, 8> previous{};
+    for (int k = 0; k <= kExposureInstants; ++k) {
+      const int64_t t = start + span * k / kExposureInstants;
+      const SE3 T_cam_object = motion.T_cam_world_at(t) * object.pose_at(t);
+      const std::array<Vec3, 8> corners = box_corners(object.bounds);
+      for (size_t c = 0; c < corners.size(); ++c) {
+        const std::optional<Vec2> p = camera.project(T_cam_object * corners[c]);
+        if (p && previous[c]) length[c] += std::hypot((*p)[0] - (*previous[c])[0], (*p)[1] - (*previous[c])[1]);
+        previous[c] = p;
+      }
+    }
+    most = std::max(most, *std::max_element(length.begin(), length.end()));
+  }
+  return most;
 }
 
 }  // namespace arpipe

@@ -16,6 +16,7 @@
 #include "render/lens/per_model_cache.h"
 #include "render/uploaded_objects.h"
 #include "render/render_session.h"
+#include "render/scene_physics.h"
 #include "render/shadow/shadow_map.h"
 #include "render/shadow/shadow_receiver.h"
 
@@ -62,6 +63,7 @@ class RenderStage final : public Stage {
     double max_predicted_uncertainty_deg = 5.0;
     bool reuse_layer = true;
     bool full_canvas = false;
+    int64_t default_exposure_ns = 0;  // motion.default_exposure_ms: for objects that move themselves
     BlurConfig blur;
     ShadowConfig shadows;
     ShadowMethod shadow_method = ShadowMethod::Off;
@@ -71,8 +73,13 @@ class RenderStage final : public Stage {
   Lighting frame_lighting(const FrameContext& ctx, double& angular_diameter_rad) const;
   // The shadow map for this frame's light, or nullptr (ctx gets a "shadow" timing saying why).
   // redrawn: whether the map changed (a layer drawn with the old one cannot be reused).
-  const ShadowLookup* shadow_for(FrameContext& ctx, const Lighting& lighting, double angular_diameter_rad,
+  const ShadowLookup* shadow_for(FrameContext& ctx, Lighting& lighting, double angular_diameter_rad,
                                  std::vector<const UploadedObject*>& drawn, bool& redrawn);
+  // Steps the physics to the frame's exposure end and places the moving objects at its middle;
+  // whether any of them moved since the last frame.
+  bool move_objects(const ShutterMotion& motion);
+  // The largest image motion of a moving object's box corners over the exposure (its own blur).
+  double moving_objects_motion_px(const ShutterMotion& motion, const CameraModel& camera) const;
   std::shared_ptr<const LensWarpMap> warp_map(const std::shared_ptr<const CameraModel>& camera_model);
   std::shared_ptr<const CameraModel> pinhole_core(const std::shared_ptr<const CameraModel>& camera_model);
 
@@ -81,10 +88,13 @@ class RenderStage final : public Stage {
   std::unique_ptr<LensWarpPass> warp_pass_;  // made by configure with render.lens = "map"
   std::unique_ptr<ShadowMapPass> shadow_pass_;  // made by configure unless render.shadows.method = "off"
   std::unique_ptr<ShadowReceiver> receiver_;
+  std::unique_ptr<ShadowMapPass> real_shadow_pass_;  // the casting proxies alone (made when there are any)
   Vec3 shadow_light_direction_{0, 0, 0};  // what the shadow map was made for (moves in steps)
   PerModelCache<LensWarpMap> warp_maps_;
   PerModelCache<CameraModel> pinhole_cores_;  // render.lens = "undistort": what the output sees
   std::vector<UploadedObject> objects_;
+  std::vector<UploadedObject> proxies_;  // [[render.proxies]], in config order
+  std::unique_ptr<ScenePhysics> physics_;  // nullptr when no object has a physics kind
   LayerReuse reuse_;
   Settings settings_;
   std::string last_error_;  // logged once per distinct message, not once per frame

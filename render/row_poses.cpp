@@ -34,8 +34,9 @@ Vec3 RowPoses::camera_point(const Vec3& p_object, const RowProjection& rows) con
 }
 
 RowPoses row_poses(const ShutterMotion& motion, const SE3& T_cam_world_fallback, const SE3& T_world_object,
-                   double exposure_fraction, bool rolling_shutter) {
+                   double exposure_fraction, bool rolling_shutter, const std::function<SE3(int64_t)>& T_world_object_at) {
   RowPoses out;
+  const auto object_at = [&](int64_t t) { return T_world_object_at ? T_world_object_at(t) : T_world_object; };
   if (!motion.valid()) {
     out.T_cam_object.push_back(T_cam_world_fallback * T_world_object);
     return out;
@@ -46,14 +47,15 @@ RowPoses row_poses(const ShutterMotion& motion, const SE3& T_cam_world_fallback,
   };
   if (!rolling_shutter || timing.readout_ns <= 0 || timing.rows <= 1) {
     // A global shutter: every row's exposure is row 0's.
-    out.T_cam_object.push_back(motion.T_cam_world_at(instant(0)) * T_world_object);
+    out.T_cam_object.push_back(motion.T_cam_world_at(instant(0)) * object_at(instant(0)));
     return out;
   }
   const int n = RowPoses::kMaxEntries;
   out.T_cam_object.reserve(n);
   for (int i = 0; i < n; ++i) {
     const double row = double(timing.rows - 1) * i / (n - 1);
-    out.T_cam_object.push_back(motion.T_cam_world_at(instant(row)) * T_world_object);
+    const int64_t t = instant(row);
+    out.T_cam_object.push_back(motion.T_cam_world_at(t) * object_at(t));
   }
   return out;
 }

@@ -3,6 +3,8 @@
 // the picture, and what the blur methods evaluate at several instants of the exposure.
 #pragma once
 
+#include <cstdint>
+#include <functional>
 #include <string_view>
 #include <vector>
 
@@ -38,8 +40,11 @@ struct RowPoses {
 // The object's poses for the instant `exposure_fraction` (0 = start, 1 = end) of each row's own
 // exposure. With a global shutter, no rolling-shutter correction asked for, or an invalid motion,
 // a single entry (the motion's pose at that instant, or T_cam_world_fallback without motion).
+// T_world_object_at: an object that moves itself (physics), its pose at each row's instant; empty:
+// fixed at T_world_object (which is also what a frame without motion uses).
 RowPoses row_poses(const ShutterMotion& motion, const SE3& T_cam_world_fallback, const SE3& T_world_object,
-                   double exposure_fraction, bool rolling_shutter);
+                   double exposure_fraction, bool rolling_shutter,
+                   const std::function<SE3(int64_t)>& T_world_object_at = {});
 
 // GLSL ES 3.00 (no #version line) declaring, for a pose table named `name`:
 //   uniform int <name>_count; uniform mat3 <name>_linear[9]; uniform vec3 <name>_translation[9];

@@ -24,19 +24,28 @@ std::string config_name(const Config& config) {
 
 // Errors name the config key as well as the file (the message from the loader names the file and
 // the place in it).
-Mesh load_mesh(const Config& config, size_t object_index, const std::string& source) {
+// key: "render.objects[2].mesh". Sized builtins (builtin:box, ...) are made at size_m.
+Mesh load_mesh(const Config& config, const std::string& key, const std::string& source, const Vec3& size_m = {0.06, 0.06, 0.06}) {
   if (is_builtin_mesh_source(source)) {
-    if (auto mesh = make_builtin_mesh(source)) return std::move(*mesh);
-    throw ConfigError(fmt::format("{}: render.objects[{}].mesh: unknown builtin mesh \"{}\" (expected "
+    if (auto mesh = make_builtin_mesh(source, size_m)) return std::move(*mesh);
+    throw ConfigError(fmt::format("{}: {}: unknown builtin mesh \"{}\" (expected "
                                   "{} or a glTF 2.0 file)",
-                                  config_name(config), object_index, source, kBuiltinMeshNames));
+                                  config_name(config), key, source, kBuiltinMeshNames));
   }
   try {
     return load_gltf_mesh(source);  // relative to the working directory, like every path in a config
   } catch (const std::exception& e) {
-    throw AssetError(fmt::format("{}: render.objects[{}].mesh = \"{}\": {}", config_name(config), object_index,
-                                 source, e.what()));
+    throw AssetError(fmt::format("{}: {} = \"{}\": {}", config_name(config), key, source, e.what()));
   }
+}
+
+// A proxy's mesh must have triangles: one without hides and catches nothing, which is never meant.
+std::shared_ptr<const Mesh> load_proxy_mesh(const Config& config, const std::string& key, const std::string& source,
+                                            const Vec3& size_m) {
+  Mesh mesh = load_mesh(config, key, source, size_m);
+  if (mesh.triangle_count() == 0)
+    throw AssetError(fmt::format("{}: {} = \"{}\": the mesh has no triangles", config_name(config), key, source));
+  return std::make_shared<const Mesh>(std::move(mesh));
 }
 
 Bounds scaled(const Bounds& box, double scale) {
@@ -97,14 +106,52 @@ LoadedMeshes load_object_meshes(const Config& config) {
     auto found = index_of.find(key);
     if (found == index_of.end()) {
       LoadedMeshes::Entry entry;
-      entry.mesh = load_mesh(config, i, object.mesh);
+      entry.mesh = load_mesh(config, fmt::format("render.objects[{}].mesh", i), object.mesh);
       entry.transfer = transfer_for(config, i, object.mesh, entry.mesh, object.prt);
       loaded.meshes.push_back(std::move(entry));
       found = index_of.emplace(key, loaded.meshes.size() - 1).first;
     }
     loaded.mesh_of_object.push_back(found->second);
   }
+  for (size_t i = 0; i < config.render.proxies.size(); ++i) {
+    const SceneProxy& proxy = config.render.proxies[i];
+    LoadedMeshes::Proxy entry;
+    entry.mesh = load_proxy_mesh(config, fmt::format("render.proxies[{}].mesh", i), proxy.mesh, proxy.size_m);
+    if (!proxy.collision_mesh.empty())
+      entry.collision = load_proxy_mesh(config, fmt::format("render.proxies[{}].collision_mesh", i), proxy.collision_mesh,
+                                        proxy.size_m);
+    loaded.proxies.push_back(std::move(entry));
+  }
   return loaded;
+}
+
+SE3 proxy_placement(const SceneProxy& proxy) {
+  return SE3::from_rt({0, 0, proxy.yaw_rad}, proxy.position_m) * SE3::from_rt({0, proxy.pitch_rad, 0}, {0, 0, 0}) *
+         SE3::from_rt({proxy.roll_rad, 0, 0}, {0, 0, 0});
+}
+
+std::vector<UploadedObject> upload_proxies(const Config& config, const LoadedMeshes& loaded) {
+  if (loaded.proxies.size() != config.render.proxies.size())
+    throw std::logic_error(fmt::format("upload_proxies: {} proxies loaded for a config with {}", loaded.proxies.size(),
+                                       config.render.proxies.size()));
+  std::vector<UploadedObject> out;
+  for (size_t i = 0; i < config.render.proxies.size(); ++i) {
+    const SceneProxy& proxy = config.render.proxies[i];
+    UploadedObject object;
+    object.mesh_source = proxy.mesh;
+    object.name = proxy.name.empty() ? fmt::format("proxy {}", i) : proxy.name;
+    object.mesh = std::make_shared<const GpuMesh>(*loaded.proxies[i].mesh);
+    object.scale = proxy.scale;
+    object.bounds = scaled(loaded.proxies[i].mesh->bounds(), proxy.scale);
+    object.T_world_object = proxy_placement(proxy);
+    object.proxy = true;
+    object.shadow_catcher = proxy.roles.receive_shadows;
+    object.writes_depth = proxy.roles.occlude;
+    object.casts_shadows = proxy.roles.cast_shadows;
+    object.base_color = std::array<float, 4>{0, 0, 0, 0};
+    out.push_back(std::move(object));
+  }
+  return out;
 }
 
 std::vector<UploadedObject> upload_objects(const Config& config, const LoadedMeshes& loaded) {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -22,10 +23,20 @@ struct UploadedObject {
   SE3 T_world_object;                    // placement without the scale
   double scale = 1.0;
   std::optional<std::array<float, 4>> base_color;  // set for builtin meshes (config colour); else the file's
-  // The real ground under the objects (render/shadow/shadow_receiver.h): drawn as the shadow's
-  // darkening, never as a surface, and it casts nothing.
+  // The real ground under the objects (render/shadow/shadow_receiver.h), or a proxy that receives
+  // shadows: drawn as the shadow's darkening, never as a surface.
   bool shadow_catcher = false;
+  // A proxy of real geometry ([[render.proxies]]): draws depth and a transparent layer (the camera
+  // shows), or the darkening of a shadow catcher; it is never shaded as a surface.
+  bool proxy = false;
+  bool writes_depth = true;   // false: a proxy that receives shadows but hides nothing
+  bool casts_shadows = true;  // virtual objects; proxies with the cast_shadows role
+  std::string name;           // a proxy's, for messages and results
   double specular = 0;  // weight of the environment's glossy reflection (config)
+  // An object moved by the physics: its pose at an instant (CLOCK_MONOTONIC ns); T_world_object is
+  // then the pose at the frame's mid-exposure. Empty: fixed at T_world_object.
+  std::function<SE3(int64_t)> pose_at;
+  bool present = true;  // false once the physics removed it (it left the world)
 };
 
 
@@ -40,12 +51,23 @@ struct LoadedMeshes {
   };
   std::vector<Entry> meshes;
   std::vector<size_t> mesh_of_object;  // per render.objects entry: its index in meshes
+  // Per render.proxies entry: its mesh (sized builtins made at size_m) and its collision mesh
+  // (collision_mesh; null: the mesh itself). Neither is scaled.
+  struct Proxy {
+    std::shared_ptr<const Mesh> mesh;
+    std::shared_ptr<const Mesh> collision;
+  };
+  std::vector<Proxy> proxies;
 };
 LoadedMeshes load_object_meshes(const Config& config);
 
 // Uploads what load_object_meshes made of this same config and places the objects; needs a current
 // GL context.
 std::vector<UploadedObject> upload_objects(const Config& config, const LoadedMeshes& loaded);
+// The same for render.proxies (UploadedObject::proxy), in config order.
+std::vector<UploadedObject> upload_proxies(const Config& config, const LoadedMeshes& loaded);
+// A proxy's placement: R = Rz(yaw) Ry(pitch) Rx(roll), at position_m.
+SE3 proxy_placement(const SceneProxy& proxy);
 
 // Both of the above, on the calling thread.
 std::vector<UploadedObject> load_and_upload_objects(const Config& config);

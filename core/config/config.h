@@ -16,6 +16,8 @@
 #include "core/config/source_choices.h"
 #include "core/config/light_source.h"
 #include "core/config/object_prt.h"
+#include "core/config/physics_choices.h"
+#include "core/config/proxy_roles.h"
 #include "core/config/probe_kind.h"
 #include "core/config/probe_method.h"
 #include "core/config/shadow_method.h"
@@ -192,6 +194,58 @@ void visit(V& v, MotionConfig& s) {
         "for frames without an exposure time; capped at the frame interval");
 }
 
+// One key of a kinematic body's pose track, relative to the physics' start (the first frame's
+// exposure start): between keys the pose moves at constant velocity, before and after it holds.
+struct PoseKey {
+  double time_s = 0;
+  Vec3 position_m{0, 0, 0};
+  double yaw_rad = 0;
+
+  bool operator==(const PoseKey&) const = default;
+};
+
+template <class V>
+void visit(V& v, PoseKey& s) {
+  v.key("time_s", s.time_s, NumberRange::closed(0, 1e6).in("s"), "since the physics started (the first frame)");
+  v.key("position_m", s.position_m, NumberRange::closed(-1e4, 1e4).in("m"), "in the world (anchor) frame");
+  v.key("yaw_deg", s.yaw_rad, Degrees{NumberRange::closed(-1e6, 1e6)}, "about world z");
+}
+
+// A virtual object as a rigid body (render/scene_physics.h, core/physics): it starts where the
+// object is placed and moves on the frames' exposure timestamps.
+struct ObjectPhysics {
+  ObjectMotion kind = ObjectMotion::None;
+  double mass_kg = 1.0;
+  Vec3 velocity_mps{0, 0, 0};        // initial, world frame
+  Vec3 spin_radps{0, 0, 0};          // initial angular velocity, world frame
+  double restitution = 0.5;
+  double friction = 0.5;
+  double rolling_friction = 0;       // metres (a torque arm); 0: a ball rolls on for ever
+  double linear_damping = 0;         // per second
+  double angular_damping = 0;
+  BodyShapeChoice shape = BodyShapeChoice::Auto;
+  std::vector<PoseKey> track;        // kinematic bodies only
+
+  bool operator==(const ObjectPhysics&) const = default;
+};
+
+template <class V>
+void visit(V& v, ObjectPhysics& s) {
+  v.key("kind", s.kind, kObjectMotionNames,
+        "none: placed as configured; static; dynamic: gravity and contacts; kinematic: follows its track");
+  v.key("mass_kg", s.mass_kg, NumberRange::closed(1e-6, 1e6).in("kg"), "dynamic bodies");
+  v.key("velocity_mps", s.velocity_mps, NumberRange::closed(-1000, 1000).in("m/s"), "initial, world frame");
+  v.key("spin_deg_s", s.spin_radps, Degrees{NumberRange::closed(-1e5, 1e5).in("degrees/s")},
+        "initial angular velocity, world frame");
+  v.key("restitution", s.restitution, NumberRange::closed(0, 1), "bounce: combined with the other surface's by product");
+  v.key("friction", s.friction, NumberRange::closed(0, 10), "combined by product");
+  v.key("rolling_friction", s.rolling_friction, NumberRange::closed(0, 10).in("m"), "0: a ball rolls on for ever");
+  v.key("linear_damping", s.linear_damping, NumberRange::closed(0, 1).in("per second"), "air drag stand-in");
+  v.key("angular_damping", s.angular_damping, NumberRange::closed(0, 1).in("per second"), "");
+  v.key("shape", s.shape, kBodyShapeNames, "collision shape; auto: from a builtin mesh, else the convex hull");
+  v.sections("track", s.track, "kinematic bodies: [[render.objects.physics.track]] pose keys, in time order");
+}
+
 struct SceneObject {
   std::string mesh = "builtin:cube";   // "builtin:cube", "builtin:pyramid", or a glTF 2.0 file
   Vec3 position_m{0, 0, 0};            // in the world (anchor) frame
@@ -204,6 +258,7 @@ struct SceneObject {
   // Weight of a glossy reflection of the environment (the 3-band radiance along the mirror
   // direction, added untinted), [0, 1]; 0: purely diffuse.
   double specular = 0;
+  ObjectPhysics physics;
 
   bool operator==(const SceneObject&) const = default;
 };
@@ -221,6 +276,75 @@ void visit(V& v, SceneObject& s) {
   v.key("prt", s.prt, kObjectPrtNames,
         "environment light: off (SH irradiance at each normal) or the baked transfer ([render.prt])");
   v.key("specular", s.specular, NumberRange::closed(0, 1), "glossy reflection of the environment, added untinted");
+  v.section("physics", s.physics, "the object as a rigid body ([render.physics]); kind = \"none\": placed as configured");
+}
+
+// Real geometry re-created as an invisible "phantom" (seed 003): a mesh placed where a real object
+// is, which hides the virtual objects behind it, catches their shadows, shadows them and stops
+// them (core/config/proxy_roles.h). Placed like an object; R = Rz(yaw) Ry(pitch) Rx(roll).
+struct SceneProxy {
+  std::string name;                    // for messages and results; "" names it by its index
+  std::string mesh = "builtin:box";    // a builtin or a glTF 2.0 file
+  Vec3 size_m{0.1, 0.1, 0.1};          // builtin:box, builtin:cylinder (diameters x, y; height z), builtin:plane (x, y)
+  Vec3 position_m{0, 0, 0};            // in the world (anchor) frame
+  double yaw_rad = 0;
+  double pitch_rad = 0;
+  double roll_rad = 0;
+  double scale = 1.0;
+  ProxyRoles roles;
+  ColliderChoice collider = ColliderChoice::Auto;
+  std::string collision_mesh;          // a (simplified) glTF file for collisions; "": the mesh
+  double restitution = 1.0;            // 1: the body's own restitution applies (combined by product)
+  double friction = 1.0;
+
+  bool operator==(const SceneProxy&) const = default;
+};
+
+template <class V>
+void visit(V& v, SceneProxy& s) {
+  v.key("name", s.name, "for messages and results");
+  v.key("mesh", s.mesh, NotEmpty{"a builtin (\"builtin:box\", \"builtin:cylinder\", ...) or a glTF file"},
+        "a builtin (box, cylinder, plane, cube, sphere, ...) or a glTF 2.0 file");
+  v.key("size_m", s.size_m, NumberRange::closed(1e-4, 1e3).in("m"),
+        "builtin:box x, y, z; builtin:cylinder diameters x, y and height z; builtin:plane x, y");
+  v.key("position_m", s.position_m, NumberRange::closed(-1e4, 1e4).in("m"), "in the world (anchor) frame");
+  v.key("yaw_deg", s.yaw_rad, Degrees{NumberRange::closed(-360, 360)}, "about world z");
+  v.key("pitch_deg", s.pitch_rad, Degrees{NumberRange::closed(-360, 360)}, "about y, before the yaw");
+  v.key("roll_deg", s.roll_rad, Degrees{NumberRange::closed(-360, 360)}, "about x, before the pitch");
+  v.key("scale", s.scale, NumberRange::closed(1e-6, 1e6), "size factor");
+  v.key("roles", s.roles, ProxyRoleNames{}, "any of \"occlude\", \"receive_shadows\", \"cast_shadows\", \"collide\"");
+  v.key("collider", s.collider, kColliderNames, "auto: from a builtin mesh, else the triangles");
+  v.key("collision_mesh", s.collision_mesh, "a (simplified) glTF file for collisions; \"\": the mesh");
+  v.key("restitution", s.restitution, NumberRange::closed(0, 1), "1: the body's own applies");
+  v.key("friction", s.friction, NumberRange::closed(0, 10), "1: the body's own applies");
+}
+
+// The rigid-body world of render.objects[].physics and the "collide" proxies (core/physics).
+struct PhysicsConfig {
+  int substep_hz = 960;                      // fixed substeps per second (bench physics: 960 is within 1 %)
+  Vec3 gravity_mps2{0, 0, -9.80665};         // world frame: z up off a table's tag
+  bool ground = true;                        // the plane z = render.shadows.receiver_height_m collides
+  int solver_iterations = 30;
+  double floor_limit_z_m = -10;              // a body below this has left the world: removed, counted
+  double world_radius_m = 1000;              // likewise beyond this distance from the origin
+  int64_t max_advance_ns = 10'000'000'000;   // one frame simulates at most this much; a longer gap freezes
+  int64_t history_ns = 500'000'000;          // kept for exposure and row poses
+
+  bool operator==(const PhysicsConfig&) const = default;
+};
+
+template <class V>
+void visit(V& v, PhysicsConfig& s) {
+  v.key("substep_hz", s.substep_hz, IntRange{60, 10000}, "fixed substeps per second");
+  v.key("gravity_mps2", s.gravity_mps2, NumberRange::closed(-1000, 1000).in("m/s^2"), "world frame (z up off the tag)");
+  v.key("ground", s.ground, "the plane z = render.shadows.receiver_height_m collides");
+  v.key("solver_iterations", s.solver_iterations, IntRange{1, 1000}, "per substep");
+  v.key("floor_limit_z_m", s.floor_limit_z_m, NumberRange::closed(-1e6, 1e6).in("m"), "a body below it is removed");
+  v.key("world_radius_m", s.world_radius_m, NumberRange::closed(1e-3, 1e7).in("m"), "a body beyond it is removed");
+  v.key("max_advance_ms", s.max_advance_ns, MillisecondsAsNs{NumberRange::closed(1, 3.6e6).in("ms")},
+        "simulated per frame at most; a longer gap freezes the world");
+  v.key("history_ms", s.history_ns, MillisecondsAsNs{NumberRange::closed(1, 60000).in("ms")},
+        "kept for exposure and row poses");
 }
 
 // Motion blur of the virtual layer (docs/ARCHITECTURE.md, "Motion blur"): how the virtual objects
@@ -303,6 +427,8 @@ void visit(V& v, PrtConfig& s) {
 struct RenderConfig {
   bool enabled = true;
   std::vector<SceneObject> objects;  // none unless the config lists them
+  std::vector<SceneProxy> proxies;   // real geometry as phantoms; none unless listed
+  PhysicsConfig physics;
   Vec3 light_direction = normalized(Vec3{0.3, -0.4, 1.0});  // world frame, towards the light; unit length
   // 0: the light is infinitely far (a directional light); > 0: a lamp this far from the world
   // origin along light_direction (shadows fan out from it).
@@ -365,6 +491,8 @@ void visit(V& v, RenderConfig& s) {
   v.section("shadows", s.shadows, "shadows of the virtual objects, on themselves and on the real ground");
   v.section("prt", s.prt, "precomputed radiance transfer, baked once per mesh (arpipe bake)");
   v.sections("objects", s.objects, "virtual objects: one [[render.objects]] each, placed in the world (anchor) frame; none when absent");
+  v.section("physics", s.physics, "rigid bodies: objects with a physics kind, proxies that collide, the ground");
+  v.sections("proxies", s.proxies, "real geometry as invisible phantoms: one [[render.proxies]] each; none when absent");
 }
 
 // A light probe sphere beside the anchor (core/light): where it is and what it is made of.

@@ -63,6 +63,15 @@ class RowWriter {
   void key(std::string_view name, double value_rad, const Degrees& rule, std::string_view help) {
     row(name, toml_float(value_rad * kDegreesPerRadian), range_text(rule.range), help);
   }
+  void key(std::string_view name, const Vec3& value_rad, const Degrees& rule, std::string_view help) {
+    row(name, vec_text(kDegreesPerRadian * value_rad), range_text(rule.range) + (rule.range.interval.empty() ? "" : " each"), help);
+  }
+  void key(std::string_view name, ProxyRoles value, const ProxyRoleNames&, std::string_view help) {
+    std::string names;
+    for (size_t i = 0; i < std::size(kProxyRoleNames); ++i)
+      if (proxy_role(value, i)) names += (names.empty() ? "" : ", ") + toml_quoted(kProxyRoleNames[i]);
+    row(name, "[" + names + "]", "distinct names", help);
+  }
   void key(std::string_view name, int64_t value_ns, const MillisecondsAsNs& rule, std::string_view help) {
     row(name, toml_float(double(value_ns) * 1e-6), range_text(rule.range), help);
   }
@@ -90,6 +99,7 @@ class RowWriter {
   template <class Section>
   void section(std::string_view name, Section& member, std::string_view help) {
     RowWriter sub(out_, path(name));
+    sub.prefix_ = prefix_;  // inside a commented-out example, commented out too
     sub.header_ = fmt::format("[{}]", sub.dotted_);
     sub.header_help_ = help;
     visit(sub, member);
@@ -103,7 +113,7 @@ class RowWriter {
     if (example) shown.emplace_back();
     for (Element& element : shown) {
       RowWriter sub(out_, path(name));
-      if (example) sub.prefix_ = "# ";
+      sub.prefix_ = example ? "# " : prefix_;
       out_ += fmt::format("{}[[{}]]\n", sub.prefix_, sub.dotted_);
       visit(sub, element);
     }

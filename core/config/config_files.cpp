@@ -59,6 +59,14 @@ void check_config_files(const Config& config) {
       if (!is_builtin_mesh_source(mesh))
         check_regular_file(config, fmt::format("render.objects[{}].mesh", i), mesh, "glTF mesh");
     }
+  if (config.render.enabled)
+    for (size_t i = 0; i < config.render.proxies.size(); ++i) {
+      const SceneProxy& proxy = config.render.proxies[i];
+      if (!is_builtin_mesh_source(proxy.mesh))
+        check_regular_file(config, fmt::format("render.proxies[{}].mesh", i), proxy.mesh, "glTF mesh");
+      if (!proxy.collision_mesh.empty())
+        check_regular_file(config, fmt::format("render.proxies[{}].collision_mesh", i), proxy.collision_mesh, "glTF mesh");
+    }
   if (config.light.source == LightSource::Environment || !config.light.environment.file.empty())
     check_regular_file(config, "light.environment.file", config.light.environment.file, "HDR environment");
 }

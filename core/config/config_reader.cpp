@@ -77,6 +77,15 @@ void check_cross_keys(const TomlSection& t, HttpSinkConfig& s) {
   if (!parse_listen_address(s.listen, why)) t.fail("listen", why, toml_quoted(s.listen));
 }
 
+void check_cross_keys(const TomlSection& t, ObjectPhysics& s) {
+  for (size_t i = 1; i < s.track.size(); ++i)
+    if (!(s.track[i].time_s > s.track[i - 1].time_s))
+      t.fail_with("track", fmt::format("expected the keys' time_s to increase; key {} has {} after {}", i,
+                                       toml_float(s.track[i].time_s), toml_float(s.track[i - 1].time_s)));
+  if (!s.track.empty() && s.kind != ObjectMotion::Kinematic)
+    t.fail_with("track", fmt::format("a pose track moves only a kinematic body, not a {} one", object_motion_name(s.kind)));
+}
+
 template <class Section>
 void check_cross_keys(const TomlSection&, Section&) {}
 
@@ -112,6 +121,29 @@ class RowReader {
   void key(std::string_view name, double& member_rad, const Degrees& rule, std::string_view) {
     if (!t_.has(name)) return t_.allow(name);  // the default stays bit for bit
     member_rad = t_.number(name, 0, rule.range) * kRadiansPerDegree;
+  }
+  void key(std::string_view name, Vec3& member_rad, const Degrees& rule, std::string_view) {
+    if (!t_.has(name)) return t_.allow(name);
+    member_rad = kRadiansPerDegree * t_.vec3(name, {0, 0, 0}, rule.range);
+  }
+  // An array of distinct role names; the roles it names are on, the others off.
+  void key(std::string_view name, ProxyRoles& member, const ProxyRoleNames&, std::string_view) {
+    const toml::node* node = t_.node(name);
+    if (node == nullptr) return;
+    const std::string expected = "an array of distinct names, each " + one_of_phrase({std::begin(kProxyRoleNames), std::end(kProxyRoleNames)});
+    const toml::array* array = node->as_array();
+    if (array == nullptr) t_.fail(name, expected, std::string(toml_type_phrase(*node)));
+    ProxyRoles roles{false, false, false, false};
+    for (const toml::node& item : *array) {
+      if (!item.is_string()) t_.fail(name, expected, std::string(toml_type_phrase(item)) + " in the array");
+      const std::string& value = item.as_string()->get();
+      const auto found = std::find(std::begin(kProxyRoleNames), std::end(kProxyRoleNames), value);
+      if (found == std::end(kProxyRoleNames)) t_.fail(name, expected, toml_quoted(value));
+      bool& flag = proxy_role(roles, static_cast<size_t>(found - std::begin(kProxyRoleNames)));
+      if (flag) t_.fail(name, expected, toml_quoted(value) + " twice");
+      flag = true;
+    }
+    member = roles;
   }
   void key(std::string_view name, int64_t& member_ns, const MillisecondsAsNs& rule, std::string_view) {
     if (!t_.has(name)) return t_.allow(name);

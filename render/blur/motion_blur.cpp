@@ -29,7 +29,7 @@ std::vector<ObjectAtInstant> objects_at(const LayerDrawRequest& request, double 
   out.reserve(request.objects.size());
   for (const UploadedObject* object : request.objects)
     out.push_back({object, row_poses(motion, request.T_cam_world, object->T_world_object, exposure_fraction,
-                                     request.rolling_shutter)});
+                                     request.rolling_shutter, object->pose_at)});
   return out;
 }
 

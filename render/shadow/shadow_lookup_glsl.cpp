@@ -179,4 +179,46 @@ void set_shadow_lookup_uniforms(const GlProgram& program, const ShadowLookup& lo
   glActiveTexture(GL_TEXTURE0);
 }
 
+namespace {
+
+// Non-uniform control flow is fine here: textureLod takes no derivatives.
+constexpr std::string_view kRealShadow = R"glsl(
+uniform bool u_real_shadow;
+uniform highp sampler2D u_real_map;
+uniform mat4 u_real_clip_from_world;
+uniform vec4 u_real_depth_plane;
+uniform float u_real_texel;
+uniform float u_real_bias;
+float real_shadow_visibility(vec3 world) {
+  if (!u_real_shadow) return 1.0;
+  vec4 clip = u_real_clip_from_world * vec4(world, 1.0);
+  vec3 p = vec3(clip.xy / clip.w * 0.5 + 0.5, dot(u_real_depth_plane, vec4(world, 1.0)));
+  if (any(lessThan(p.xy, vec2(0.0))) || any(greaterThan(p.xy, vec2(1.0))) || p.z >= 1.0) return 1.0;
+  float sum = 0.0;
+  for (int y = -1; y <= 1; ++y)
+    for (int x = -1; x <= 1; ++x)
+      sum += p.z - u_real_bias <= textureLod(u_real_map, p.xy + vec2(x, y) * u_real_texel, 0.0).r ? 1.0 : 0.0;
+  return sum / 9.0;
+}
+)glsl";
+
+}  // namespace
+
+std::string real_shadow_lookup_glsl() { return std::string(kRealShadow); }
+
+void set_real_shadow_uniforms(const GlProgram& program, const ShadowLookup* lookup, int texture_unit) {
+  glUniform1i(program.uniform("u_real_shadow"), lookup ? 1 : 0);
+  if (!lookup) return;
+  glActiveTexture(static_cast<GLenum>(GL_TEXTURE0 + texture_unit));
+  glBindTexture(GL_TEXTURE_2D, lookup->texture);
+  glUniform1i(program.uniform("u_real_map"), texture_unit);
+  glUniformMatrix4fv(program.uniform("u_real_clip_from_world"), 1, GL_FALSE, lookup->clip_from_world.data());
+  glUniform4fv(program.uniform("u_real_depth_plane"), 1, lookup->depth_plane.data());
+  glUniform1f(program.uniform("u_real_texel"), lookup->texel);
+  // Twice the map's own bias: a real surface is both caster and receiver in this map, so acne
+  // would show as a false real shadow that cancels a virtual one.
+  glUniform1f(program.uniform("u_real_bias"), 2 * lookup->bias);
+  glActiveTexture(GL_TEXTURE0);
+}
+
 }  // namespace arpipe

@@ -208,7 +208,9 @@ log_level = "debug"
   EXPECT_NEAR(c.render.objects[0].yaw_rad, kPi, 1e-15);
   EXPECT_EQ(c.render.objects[0].scale, 0.5);
   EXPECT_EQ(c.render.objects[0].color, (Vec3{0.2, 0.8, 0.2}));
-  EXPECT_EQ(c.render.objects[1], (SceneObject{"assets/duck.gltf"}));  // the rest at defaults
+  SceneObject duck;
+  duck.mesh = "assets/duck.gltf";
+  EXPECT_EQ(c.render.objects[1], duck);  // the rest at defaults
   EXPECT_FALSE(c.sinks.png.enabled);
   EXPECT_EQ(c.sinks.png.dir, "o/png");
   EXPECT_EQ(c.sinks.png.every, 10);
