@@ -135,7 +135,7 @@ const char* kTriangleGltf = R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"
 
 TEST(SimSceneLoaderExamples, EveryExampleLoadsAndSaysWhatItIsFor) {
   const std::set<std::string> expected{"blur-bench.toml", "calib-board.toml", "default.toml", "probe-indoor.toml", "rolling-shutter.toml",
-                                       "sun-outdoor.toml", "tag-pan.toml", "tag-static.toml"};
+                                       "proxies.toml", "sun-outdoor.toml", "tag-pan.toml", "tag-static.toml"};
   std::set<std::string> found;
   for (const auto& entry : fs::directory_iterator(kScenes)) {
     if (entry.path().extension() != ".toml") continue;
