@@ -25,6 +25,7 @@ void add_cameras_command(CLI::App& arpipe);   // arpipe cameras [--v4l2-only | -
 void add_record_command(CLI::App& arpipe);    // arpipe record --camera CAMERA --out DIR [--frames N | --seconds S] ...
 void add_config_command(CLI::App& arpipe);    // arpipe config --defaults | --check FILE
 void add_ctl_command(CLI::App& arpipe);       // arpipe ctl [--socket PATH] status | reload | set K=V... | snapshot FILE | record start DIR | record stop
+void add_proxy_command(CLI::App& arpipe);     // arpipe proxy simplify IN --out OUT.glb [--ratio R] [--camera FILE] ...
 
 // Every command, in the order `arpipe --help` lists them.
 using AddCommand = void (*)(CLI::App& arpipe);
@@ -32,7 +33,7 @@ inline constexpr AddCommand kCommands[] = {
     add_inspect_command, add_replay_command, add_simulate_command, add_calib_command,
     add_board_command,   add_bench_command,  add_sh_command,       add_bake_command,
     add_sun_command,     add_cameras_command, add_record_command,  add_config_command,
-    add_ctl_command,
+    add_ctl_command,     add_proxy_command,
 };
 
 }  // namespace arpipe
