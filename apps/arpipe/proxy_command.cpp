@@ -79,7 +79,7 @@ Mesh load_proxy_input(const std::string& input) {
 }
 
 std::string closed_text(size_t unpaired_edges) {
-  return unpaired_edges == 0 ? std::string("yes") : fmt::format("no ({} unpaired edges)", unpaired_edges);
+  return unpaired_edges == 0 ? std::string("yes") : fmt::format("no: {} unpaired edges", unpaired_edges);
 }
 
 double milliseconds_since(std::chrono::steady_clock::time_point start) {
@@ -144,8 +144,9 @@ int simplify_proxy(ProxySimplifyOptions options) {
   const size_t after = result.mesh.triangle_count();
   std::printf("proxy            %s -> %s\n", options.input.c_str(), out.string().c_str());
   std::printf("                   triangles   vertices  closed\n");
-  std::printf("  original        %10zu %10zu  %s (%zu positions after the weld)\n", result.input_triangles,
-              result.input_vertices, closed_text(result.input_unpaired_edges).c_str(), result.welded_vertices);
+  std::printf("  original        %10zu %10zu\n", result.input_triangles, result.input_vertices);
+  std::printf("  welded          %10zu %10zu  %s\n", result.welded_triangles, result.welded_vertices,
+              closed_text(result.input_unpaired_edges).c_str());
   std::printf("  simplified      %10zu %10zu  %s\n", after, result.mesh.vertex_count(),
               closed_text(result.output_unpaired_edges).c_str());
   std::printf("ratio            %.2f:1 (asked %g:1: at most %zu triangles)\n", double(result.input_triangles) / double(after),
