@@ -24,6 +24,7 @@
 #include "capture/sinks/output_path.h"
 #include "core/geometry/camera_model.h"
 #include "core/geometry/se3.h"
+#include "core/pipeline/monotonic_clock.h"
 #include "core/scene/builtin_meshes.h"
 #include "core/scene/glb_writer.h"
 #include "core/scene/gltf_loader.h"
@@ -78,12 +79,8 @@ Mesh load_proxy_input(const std::string& input) {
   return std::move(*builtin);
 }
 
-std::string closed_text(size_t unpaired_edges) {
+std::string proxy_closed_text(size_t unpaired_edges) {
   return unpaired_edges == 0 ? std::string("yes") : fmt::format("no: {} unpaired edges", unpaired_edges);
-}
-
-double milliseconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
 int simplify_proxy(ProxySimplifyOptions options) {
@@ -146,9 +143,9 @@ int simplify_proxy(ProxySimplifyOptions options) {
   std::printf("                   triangles   vertices  closed\n");
   std::printf("  original        %10zu %10zu\n", result.input_triangles, result.input_vertices);
   std::printf("  welded          %10zu %10zu  %s\n", result.welded_triangles, result.welded_vertices,
-              closed_text(result.input_unpaired_edges).c_str());
+              proxy_closed_text(result.input_unpaired_edges).c_str());
   std::printf("  simplified      %10zu %10zu  %s\n", after, result.mesh.vertex_count(),
-              closed_text(result.output_unpaired_edges).c_str());
+              proxy_closed_text(result.output_unpaired_edges).c_str());
   std::printf("ratio            %.2f:1 (asked %g:1: at most %zu triangles)\n", double(result.input_triangles) / double(after),
               options.settings.ratio, result.target_triangles);
   std::printf("method           %s (--max-error %g)\n", std::string(simplify_method_name(result.method)).c_str(),

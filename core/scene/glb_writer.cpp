@@ -21,8 +21,8 @@ static_assert(std::endian::native == std::endian::little, "the .glb's binary chu
 constexpr uint32_t kGlbWriterMagic = 0x46546C67;      // "glTF"
 constexpr uint32_t kGlbWriterJsonChunk = 0x4E4F534A;  // "JSON"
 constexpr uint32_t kGlbWriterBinChunk = 0x004E4942;   // "BIN\0"
-constexpr int kGltfFloat = 5126, kGltfUnsignedInt = 5125;
-constexpr int kGltfArrayBuffer = 34962, kGltfElementArrayBuffer = 34963;
+constexpr int kGlbWriterFloat = 5126, kGlbWriterUnsignedInt = 5125;
+constexpr int kGlbWriterArrayBuffer = 34962, kGlbWriterElementArrayBuffer = 34963;
 
 // The BIN chunk as it grows, and the bufferViews and accessors that describe it.
 class GlbBinaryBuilder {
@@ -43,8 +43,8 @@ class GlbBinaryBuilder {
   // float3 per vertex in glTF's axes; POSITION accessors carry min and max (the spec asks for them).
   size_t add_vec3_accessor(const std::vector<float>& xyz, bool with_bounds) {
     const size_t count = xyz.size() / 3;
-    nlohmann::json accessor = {{"bufferView", add_view(xyz.data(), xyz.size() * sizeof(float), kGltfArrayBuffer)},
-                               {"componentType", kGltfFloat},
+    nlohmann::json accessor = {{"bufferView", add_view(xyz.data(), xyz.size() * sizeof(float), kGlbWriterArrayBuffer)},
+                               {"componentType", kGlbWriterFloat},
                                {"count", count},
                                {"type", "VEC3"}};
     if (with_bounds) {
@@ -71,7 +71,7 @@ class GlbBinaryBuilder {
   nlohmann::json accessors_ = nlohmann::json::array();
 };
 
-void check_encodable(const Mesh& mesh) {
+void check_glb_encodable(const Mesh& mesh) {
   const std::string name = mesh.source.empty() ? std::string("the mesh") : mesh.source;
   auto fail = [&](const std::string& what) { throw std::invalid_argument(fmt::format("{}: {}", name, what)); };
   if (mesh.positions.size() % 3 != 0 || mesh.indices.size() % 3 != 0 || mesh.indices.empty())
@@ -94,14 +94,14 @@ void check_encodable(const Mesh& mesh) {
       if (!std::isfinite(c)) fail("a part's base colour is not finite");
 }
 
-void append_u32(std::vector<uint8_t>& out, uint32_t value) {
+void append_glb_u32(std::vector<uint8_t>& out, uint32_t value) {
   for (int i = 0; i < 4; ++i) out.push_back(static_cast<uint8_t>(value >> (8 * i)));
 }
 
 }  // namespace
 
 std::vector<uint8_t> encode_glb(const Mesh& mesh, std::string_view generator) {
-  check_encodable(mesh);
+  check_glb_encodable(mesh);
   std::vector<MeshPart> parts = mesh.parts;
   if (parts.empty()) parts.push_back(MeshPart{0, static_cast<uint32_t>(mesh.indices.size()), {1, 1, 1, 1}});
 
@@ -134,9 +134,9 @@ std::vector<uint8_t> encode_glb(const Mesh& mesh, std::string_view generator) {
     nlohmann::json attributes = {{"POSITION", builder.add_vec3_accessor(positions, true)}};
     if (!normals.empty()) attributes["NORMAL"] = builder.add_vec3_accessor(normals, false);
     const size_t index_view =
-        builder.add_view(indices.data(), indices.size() * sizeof(uint32_t), kGltfElementArrayBuffer);
+        builder.add_view(indices.data(), indices.size() * sizeof(uint32_t), kGlbWriterElementArrayBuffer);
     const size_t index_accessor = builder.add_accessor(
-        {{"bufferView", index_view}, {"componentType", kGltfUnsignedInt}, {"count", indices.size()}, {"type", "SCALAR"}});
+        {{"bufferView", index_view}, {"componentType", kGlbWriterUnsignedInt}, {"count", indices.size()}, {"type", "SCALAR"}});
 
     auto colour = std::find(colours.begin(), colours.end(), part.base_color);
     if (colour == colours.end()) {
@@ -175,14 +175,14 @@ std::vector<uint8_t> encode_glb(const Mesh& mesh, std::string_view generator) {
         fmt::format("{}: {} bytes, over the 4 GiB a .glb can hold", mesh.source.empty() ? "the mesh" : mesh.source, total));
   std::vector<uint8_t> out;
   out.reserve(static_cast<size_t>(total));
-  append_u32(out, kGlbWriterMagic);
-  append_u32(out, 2);
-  append_u32(out, static_cast<uint32_t>(total));
-  append_u32(out, static_cast<uint32_t>(json_text.size()));
-  append_u32(out, kGlbWriterJsonChunk);
+  append_glb_u32(out, kGlbWriterMagic);
+  append_glb_u32(out, 2);
+  append_glb_u32(out, static_cast<uint32_t>(total));
+  append_glb_u32(out, static_cast<uint32_t>(json_text.size()));
+  append_glb_u32(out, kGlbWriterJsonChunk);
   out.insert(out.end(), json_text.begin(), json_text.end());
-  append_u32(out, static_cast<uint32_t>(bin.size()));
-  append_u32(out, kGlbWriterBinChunk);
+  append_glb_u32(out, static_cast<uint32_t>(bin.size()));
+  append_glb_u32(out, kGlbWriterBinChunk);
   out.insert(out.end(), bin.begin(), bin.end());
   return out;
 }
