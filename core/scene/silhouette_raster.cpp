@@ -18,6 +18,9 @@ namespace {
 // share an edge then leave no sample uncovered to rounding.
 constexpr double kSilhouetteEdgeSlackPx = 1e-9;
 
+// One bit per sample: 2^31 samples are 256 MiB a mask (a 4096 x 3000 camera at 4 x 4 is 2^27.5).
+constexpr uint64_t kMaxSilhouetteSamples = uint64_t{1} << 31;
+
 // x * samples - 0.5 .. the sample index whose centre is at pixel coordinate x.
 double silhouette_sample_coordinate(double pixel, int samples) { return (pixel + 0.5) * samples - 0.5; }
 
@@ -29,6 +32,12 @@ SilhouetteMask::SilhouetteMask(int width, int height, int samples_per_axis)
     throw std::invalid_argument(fmt::format("a silhouette mask of {} x {} pixels (1 to 16384 each way)", width, height));
   if (samples_per_axis < 1 || samples_per_axis > 16)
     throw std::invalid_argument(fmt::format("{} samples per pixel axis (1 to 16)", samples_per_axis));
+  const uint64_t samples = uint64_t(width) * uint64_t(height) * uint64_t(samples_per_axis) * uint64_t(samples_per_axis);
+  if (samples > kMaxSilhouetteSamples)
+    throw std::invalid_argument(fmt::format("a silhouette mask of {} x {} pixels with {} x {} samples each: {} samples, "
+                                            "over the limit of {} (256 MiB); use fewer samples per pixel",
+                                            width, height, samples_per_axis, samples_per_axis, samples,
+                                            kMaxSilhouetteSamples));
   columns_ = width * samples_per_axis;
   rows_ = height * samples_per_axis;
   words_per_row_ = (static_cast<size_t>(columns_) + 63) / 64;

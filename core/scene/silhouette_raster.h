@@ -18,7 +18,8 @@ namespace arpipe {
 // of its sub-squares.
 class SilhouetteMask {
  public:
-  // Throws std::invalid_argument unless 1 <= width, height <= 16384 and 1 <= samples_per_axis <= 16.
+  // Throws std::invalid_argument unless 1 <= width, height <= 16384, 1 <= samples_per_axis <= 16
+  // and the mask holds at most 2^31 samples (256 MiB).
   SilhouetteMask(int width, int height, int samples_per_axis = 4);
 
   int width() const { return width_; }

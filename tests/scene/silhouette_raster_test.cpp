@@ -120,6 +120,7 @@ TEST(SilhouetteRaster, EmptyReferenceHasNoErrorToMeasure) {
   EXPECT_TRUE(std::isnan(silhouette_edge_error(empty, other).error_px));
   EXPECT_THROW(SilhouetteMask(0, 10, 4), std::invalid_argument);
   EXPECT_THROW(SilhouetteMask(10, 10, 0), std::invalid_argument);
+  EXPECT_THROW(SilhouetteMask(16384, 16384, 4), std::invalid_argument);  // 2^32 samples: over 2^31
   EXPECT_THROW(SilhouetteMask(10, 10, 4).symmetric_difference_px(SilhouetteMask(10, 10, 2)), std::invalid_argument);
 }
 
