@@ -19,6 +19,7 @@ void add_benchmarks(CLI::App& bench) {
   add_sh_benchmark(bench);
   add_prt_benchmark(bench);
   add_physics_benchmark(bench);
+  add_proxies_benchmark(bench);
 }
 
 }  // namespace arpipe

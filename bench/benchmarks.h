@@ -25,5 +25,6 @@ void add_calib_solve_benchmark(CLI::App& bench);    // calib-solve: calibration 
 void add_sh_benchmark(CLI::App& bench);             // sh: spherical-harmonic error against bands (sh_accuracy.cpp)
 void add_prt_benchmark(CLI::App& bench);            // prt: PRT bake time against error, run-time cost (prt_bake_accuracy.cpp)
 void add_physics_benchmark(CLI::App& bench);        // physics: time per frame against bounce error, per substep rate (physics_cost.cpp)
+void add_proxies_benchmark(CLI::App& bench);        // proxies: render time against occlusion edge error, full and simplified (proxies_cost.cpp)
 
 }  // namespace arpipe

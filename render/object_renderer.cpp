@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <array>
 
 #include "core/sh/sh_rotation.h"
@@ -63,6 +64,11 @@ uniform bool u_proxy;            // real geometry: depth only, or the catcher's 
 out vec4 out_color;              // linear, premultiplied alpha
 {shadow_lookup}
 {real_shadow_lookup}
+uniform bool u_real_shadow;    // a map of the real casters alone is bound
+// The virtual objects as spheres of their mean projected area (xyz: centre, world; w: radius).
+uniform int u_sky_occluder_count;
+uniform vec4 u_sky_occluders[{max_sky_occluders}];
+
 vec3 sh9_at(vec3 c[9], vec3 n) {{
   return 0.282095 * c[0] + 0.488603 * (n.y * c[1] + n.z * c[2] + n.x * c[3])
        + 1.092548 * (n.x * n.y * c[4] + n.y * n.z * c[5] + n.x * n.z * c[7])
@@ -71,12 +77,31 @@ vec3 sh9_at(vec3 c[9], vec3 n) {{
 
 vec3 ambient_at(vec3 n) {{ return u_ambient + sh9_at(u_ambient_sh, n); }}
 
+// The share of a surface's ambient irradiance that the virtual objects hide: a sphere of radius r
+// at distance d in direction w, a above the horizon, covers pi (r / d)^2 of solid angle, so it
+// hides pi (r / d)^2 cos(a) L(w) of E(n) = pi ambient_at(n): (r / d)^2 cos(a) for a uniform sky
+// (exact while the sphere is wholly above the horizon), more where the ambient light comes from.
+float sky_occlusion(vec3 p, vec3 n, float ambient) {{
+  const vec3 luma = vec3(0.2126, 0.7152, 0.0722);
+  if (ambient <= 0.0) return 0.0;
+  float hidden = 0.0;
+  for (int i = 0; i < u_sky_occluder_count; ++i) {{
+    vec3 d = u_sky_occluders[i].xyz - p;
+    float r = u_sky_occluders[i].w, d2 = max(dot(d, d), r * r);
+    vec3 w = d * inversesqrt(d2);
+    float radiance = max(dot(sh9_at(u_radiance_sh, w), luma), 0.0);
+    hidden += clamp(dot(n, w), 0.0, 1.0) * r * r / d2 * radiance / ambient;
+  }}
+  return min(hidden, 1.0);
+}}
+
 void main() {{
   vec3 normal = normalize(v_normal_world);
   if (!gl_FrontFacing) normal = -normal;  // the inside of an open mesh faces the other way
   vec3 towards_light = u_light_position.w > 0.5 ? normalize(u_light_position.xyz - v_world) : u_light_direction;
   float lambert = max(dot(normal, towards_light), 0.0);
   float visibility = shadow_visibility(v_world);  // uniform control flow: it takes derivatives
+  float real_visibility = u_real_shadow ? real_shadow_visibility(v_world) : 1.0;  // a uniform's branch
   if (u_shadow_catcher) {{
     // Differential rendering: the real surface's light with the virtual shadow over its light
     // without it, where the real casters already shade it as they do in the picture. One ratio
@@ -84,8 +109,9 @@ void main() {{
     const vec3 luma = vec3(0.2126, 0.7152, 0.0722);
     float ambient = max(dot(ambient_at(normal), luma), 0.0);
     float direct = dot(u_light_color, luma) * lambert;
-    float real_direct = direct * real_shadow_visibility(v_world);
-    float ratio = ambient + real_direct > 0.0 ? min((ambient + visibility * direct) / (ambient + real_direct), 1.0) : 1.0;
+    float real_direct = direct * real_visibility;
+    float lit = ambient * (1.0 - sky_occlusion(v_world, normal, ambient)) + visibility * direct;
+    float ratio = ambient + real_direct > 0.0 ? min(lit / (ambient + real_direct), 1.0) : 1.0;
     out_color = vec4(0.0, 0.0, 0.0, 1.0 - ratio);
     return;
   }}
@@ -193,7 +219,8 @@ const GlProgram& ObjectRenderer::shading(ShadowMethod method) {
   if (found == shading_.end()) {
     const std::string fragment = fmt::format(fmt::runtime(kShadingFragmentShaderTemplate),
                                              fmt::arg("shadow_lookup", shadow_lookup_glsl(method)),
-                                             fmt::arg("real_shadow_lookup", real_shadow_lookup_glsl()));
+                                             fmt::arg("real_shadow_lookup", shadow_lookup_glsl(method, "real_")),
+                                             fmt::arg("max_sky_occluders", Lighting::kMaxSkyOccluders));
     found = shading_
                 .emplace(method, GlProgram(fmt::format("object shading ({} shadows)", shadow_method_name(method)),
                                            vertex_source({"pose"}, kShadingVertexShader), fragment))
@@ -223,7 +250,15 @@ void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, c
   glUniform3fv(program.uniform("u_radiance_sh"), 9, sh.data());
   glUniform1f(program.uniform("u_exposure_scale"), static_cast<float>(lighting.exposure_scale));
   if (lighting.shadow) set_shadow_lookup_uniforms(program, *lighting.shadow, 1);
-  set_real_shadow_uniforms(program, lighting.shadow ? lighting.real_shadow : nullptr, 2);
+  // Without shadows the catcher never runs and the compiler drops these: set only those it kept.
+  const auto location = [&](const char* name) { return glGetUniformLocation(program.id(), name); };
+  const bool real = lighting.shadow && lighting.real_shadow;
+  if (location("u_real_shadow") >= 0) glUniform1i(location("u_real_shadow"), real ? 1 : 0);
+  if (real) set_shadow_lookup_uniforms(program, *lighting.real_shadow, 2, "real_");
+  const int sky_occluders = static_cast<int>(std::min(lighting.sky_occluders.size(), Lighting::kMaxSkyOccluders));
+  if (location("u_sky_occluder_count") >= 0) glUniform1i(location("u_sky_occluder_count"), sky_occluders);
+  if (sky_occluders > 0 && location("u_sky_occluders") >= 0)
+    glUniform4fv(location("u_sky_occluders"), sky_occluders, lighting.sky_occluders[0].data());
   const GLint world_from_object_rotation = program.uniform("u_world_from_object_rotation");
   const GLint world_from_object_translation = program.uniform("u_world_from_object_translation");
   const GLint object_scale = program.uniform("u_object_scale");

@@ -6,6 +6,7 @@
 #include <array>
 #include <map>
 #include <span>
+#include <vector>
 
 #include "render/gl/gl_program.h"
 #include "render/lens/lens_projection.h"
@@ -32,8 +33,12 @@ struct Lighting {
   double exposure_scale = 1;
   const ShadowLookup* shadow = nullptr;  // nullptr: nothing is shadowed
   // The real casters' own map (proxies with cast_shadows); nullptr: none. The catcher's ratio is
-  // (ambient + visibility * direct) / (ambient + real visibility * direct).
+  // (ambient (1 - sky occlusion) + visibility * direct) / (ambient + real visibility * direct).
   const ShadowLookup* real_shadow = nullptr;
+  // The virtual objects that hide part of the sky from the catchers: spheres of their mean
+  // projected area (x, y, z world, radius), at most kMaxSkyOccluders (the rest are left out).
+  static constexpr size_t kMaxSkyOccluders = 16;
+  std::vector<std::array<float, 4>> sky_occluders;
 };
 
 struct ObjectAtInstant {

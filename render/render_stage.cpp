@@ -76,6 +76,8 @@ void RenderStage::configure_loaded(const Config& config, const std::shared_ptr<c
   std::vector<UploadedObject> proxies = upload_proxies(config, loaded->meshes);
   auto physics = std::make_unique<ScenePhysics>(config, loaded->meshes);
   if (physics->empty()) physics.reset();
+  std::unique_ptr<OcclusionMeter> occlusion_meter;
+  if (!config.render.proxies.empty() || physics) occlusion_meter = std::make_unique<OcclusionMeter>(config, loaded->meshes);
 
   Settings settings;
   settings.enabled = config.render.enabled;
@@ -104,9 +106,9 @@ void RenderStage::configure_loaded(const Config& config, const std::shared_ptr<c
   if (!receiver_) receiver_ = std::make_unique<ShadowReceiver>();
   // The real casters' map: a depth map for the catcher's real visibility (shadow_lookup_glsl.h).
   const bool real_casters = std::any_of(proxies.begin(), proxies.end(), [](const UploadedObject& p) { return p.casts_shadows; });
-  ShadowConfig real_shadow_config = settings.shadows;
-  real_shadow_config.method = ShadowMethod::Pcf;
-  real_shadow_config.pcf_kernel = 3;
+  // The same method and size as the main map, so that where no virtual object casts, the two
+  // lookups agree exactly and the catcher's ratio is 1.
+  const ShadowConfig& real_shadow_config = settings.shadows;
   if (settings.shadow_method == ShadowMethod::Off || !real_casters) real_shadow_pass_.reset();
   else if (!real_shadow_pass_ || real_shadow_pass_->config() != real_shadow_config)
     real_shadow_pass_ = std::make_unique<ShadowMapPass>(session_->context(), real_shadow_config);
@@ -118,6 +120,7 @@ void RenderStage::configure_loaded(const Config& config, const std::shared_ptr<c
   objects_ = std::move(objects);
   proxies_ = std::move(proxies);
   physics_ = std::move(physics);
+  occlusion_meter_ = std::move(occlusion_meter);
   reuse_.forget();  // new objects or settings: draw again
   if (settings.lens_canvas_scale != settings_.lens_canvas_scale) warp_maps_.clear();
   settings_ = settings;
@@ -217,6 +220,11 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
     motion.max_image_motion_px = 0;
   }
   if (physics_ && move_objects(motion)) reuse_.forget();
+  if (occlusion_meter_) {
+    const auto measure_start = std::chrono::steady_clock::now();
+    ctx.objects = occlusion_meter_->measure(camera, ctx.pose.T_cam_world, objects_, proxies_);
+    ctx.record_timing("occlusion", milliseconds_since(measure_start));
+  }
 
   // The rectangle the objects can reach over the exposure (blurred, or skewed by a rolling
   // shutter): their boxes at 9 instants from its start to its end, so that a path whose ends lie
@@ -394,8 +402,15 @@ const ShadowLookup* RenderStage::shadow_for(FrameContext& ctx, Lighting& lightin
     caster_objects.push_back(&object);
     extent = std::max(extent, norm(object.bounds.max - object.bounds.min));
   };
+  lighting.sky_occluders.clear();
   for (const UploadedObject& object : objects_)
-    if (object.present) add_caster(object);
+    if (object.present) {
+      add_caster(object);
+      if (!settings_.shadows.sky_occlusion) continue;
+      const Vec3 centre = object.T_world_object * (0.5 * (object.bounds.min + object.bounds.max));
+      lighting.sky_occluders.push_back({static_cast<float>(centre[0]), static_cast<float>(centre[1]),
+                                        static_cast<float>(centre[2]), static_cast<float>(object.sky_radius_m)});
+    }
   for (const UploadedObject& proxy : proxies_)
     if (proxy.casts_shadows) {
       add_caster(proxy);
@@ -415,6 +430,7 @@ const ShadowLookup* RenderStage::shadow_for(FrameContext& ctx, Lighting& lightin
   bool drew = shadow_pass_->render(*frustum, caster_objects, angular_diameter_rad);
   lighting.real_shadow = nullptr;
   if (real_shadow_pass_ && !real_casters.empty()) {
+    if (is_variance_method(settings_.shadow_method)) real_casters.push_back(&catcher);  // as in the main map
     drew = real_shadow_pass_->render(*frustum, real_casters, angular_diameter_rad) || drew;
     lighting.real_shadow = &real_shadow_pass_->lookup();
   }

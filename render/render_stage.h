@@ -17,6 +17,7 @@
 #include "render/uploaded_objects.h"
 #include "render/render_session.h"
 #include "render/scene_physics.h"
+#include "render/occlusion_meter.h"
 #include "render/shadow/shadow_map.h"
 #include "render/shadow/shadow_receiver.h"
 
@@ -95,6 +96,7 @@ class RenderStage final : public Stage {
   std::vector<UploadedObject> objects_;
   std::vector<UploadedObject> proxies_;  // [[render.proxies]], in config order
   std::unique_ptr<ScenePhysics> physics_;  // nullptr when no object has a physics kind
+  std::unique_ptr<OcclusionMeter> occlusion_meter_;  // with proxies or physics: ctx.objects
   LayerReuse reuse_;
   Settings settings_;
   std::string last_error_;  // logged once per distinct message, not once per frame

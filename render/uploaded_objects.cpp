@@ -95,6 +95,19 @@ std::vector<float> transfer_for(const Config& config, size_t object_index, const
   return first9;
 }
 
+// sqrt(area / (4 pi)): the sphere whose cross-section is the mesh's mean projected area.
+double mean_projected_radius(const Mesh& mesh) {
+  double area = 0;
+  for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+    const auto at = [&](uint32_t i) {
+      return Vec3{mesh.positions[3 * size_t(i)], mesh.positions[3 * size_t(i) + 1], mesh.positions[3 * size_t(i) + 2]};
+    };
+    const Vec3 a = at(mesh.indices[t]), b = at(mesh.indices[t + 1]), c = at(mesh.indices[t + 2]);
+    area += 0.5 * norm(cross(b - a, c - a));
+  }
+  return std::sqrt(area / (4 * 3.14159265358979323846));
+}
+
 }  // namespace
 
 LoadedMeshes load_object_meshes(const Config& config) {
@@ -115,6 +128,13 @@ LoadedMeshes load_object_meshes(const Config& config) {
   }
   for (size_t i = 0; i < config.render.proxies.size(); ++i) {
     const SceneProxy& proxy = config.render.proxies[i];
+    // A sized builtin needs every size it uses (a plane's z is not used).
+    const size_t sizes_used = proxy.mesh == "builtin:plane" ? 2 : 3;
+    if (builtin_mesh_is_sized(proxy.mesh))
+      for (size_t k = 0; k < sizes_used; ++k)
+        if (!(proxy.size_m[k] > 0))
+          throw ConfigError(fmt::format("{}: render.proxies[{}].size_m[{}]: expected a size above 0 m for {}, found {}",
+                                        config_name(config), i, k, proxy.mesh, proxy.size_m[k]));
     LoadedMeshes::Proxy entry;
     entry.mesh = load_proxy_mesh(config, fmt::format("render.proxies[{}].mesh", i), proxy.mesh, proxy.size_m);
     if (!proxy.collision_mesh.empty())
@@ -171,6 +191,7 @@ std::vector<UploadedObject> upload_objects(const Config& config, const LoadedMes
     out.scale = object.scale;
     out.specular = object.specular;
     out.bounds = scaled(loaded.meshes[m].mesh.bounds(), object.scale);
+    out.sky_radius_m = object.scale * mean_projected_radius(loaded.meshes[m].mesh);
     out.T_world_object = SE3::from_rt({0, 0, object.yaw_rad}, object.position_m);
     if (is_builtin_mesh_source(object.mesh))
       out.base_color = std::array<float, 4>{static_cast<float>(object.color[0]), static_cast<float>(object.color[1]),

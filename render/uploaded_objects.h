@@ -37,6 +37,9 @@ struct UploadedObject {
   // then the pose at the frame's mid-exposure. Empty: fixed at T_world_object.
   std::function<SE3(int64_t)> pose_at;
   bool present = true;  // false once the physics removed it (it left the world)
+  // The radius of a sphere with the object's mean projected area (a convex body's is a quarter of
+  // its surface), scaled: how much sky it hides from the ground beside it (object_renderer.h).
+  double sky_radius_m = 0;
 };
 
 

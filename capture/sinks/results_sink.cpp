@@ -90,6 +90,20 @@ nlohmann::json ResultsSink::to_json(const FrameContext& ctx) {
   }
   j["virtual_layer_drawn"] = ctx.virtual_layer_drawn;
   if (ctx.virtual_layer_drawn) j["blur"] = {{"method", ctx.blur_method}, {"samples", ctx.blur_samples}};
+  if (!ctx.objects.empty()) {
+    json objects = json::array();
+    for (const ObjectReport& o : ctx.objects) {
+      json hidden_by = json::object();
+      for (const auto& [name, share] : o.hidden_by) hidden_by[name] = share;
+      objects.push_back({{"index", o.index},
+                         {"position_m", {o.position_m[0], o.position_m[1], o.position_m[2]}},
+                         {"present", o.present},
+                         {"in_view", o.in_view},
+                         {"hidden", o.hidden},
+                         {"hidden_by", std::move(hidden_by)}});
+    }
+    j["objects"] = std::move(objects);
+  }
   json timings = json::object();
   json skips = json::object();
   for (const auto& t : ctx.timings) {

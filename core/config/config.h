@@ -305,8 +305,8 @@ void visit(V& v, SceneProxy& s) {
   v.key("name", s.name, "for messages and results");
   v.key("mesh", s.mesh, NotEmpty{"a builtin (\"builtin:box\", \"builtin:cylinder\", ...) or a glTF file"},
         "a builtin (box, cylinder, plane, cube, sphere, ...) or a glTF 2.0 file");
-  v.key("size_m", s.size_m, NumberRange::closed(1e-4, 1e3).in("m"),
-        "builtin:box x, y, z; builtin:cylinder diameters x, y and height z; builtin:plane x, y");
+  v.key("size_m", s.size_m, NumberRange::closed(0, 1e3).in("m"),
+        "builtin:box x, y, z; builtin:cylinder diameters x, y and height z; builtin:plane x, y (each > 0 that the mesh uses)");
   v.key("position_m", s.position_m, NumberRange::closed(-1e4, 1e4).in("m"), "in the world (anchor) frame");
   v.key("yaw_deg", s.yaw_rad, Degrees{NumberRange::closed(-360, 360)}, "about world z");
   v.key("pitch_deg", s.pitch_rad, Degrees{NumberRange::closed(-360, 360)}, "about y, before the yaw");
@@ -385,6 +385,9 @@ struct ShadowConfig {
   // The size of the config's fixed light (render.light_direction), for pcss; probe and sun
   // estimates bring their own (0.53 degrees for the sun).
   double light_angular_diameter_deg = 2.0;
+  // The virtual objects also hide part of the ambient light from the real surfaces beside them
+  // (each as a sphere of its mean projected area); the catcher darkens those surfaces too.
+  bool sky_occlusion = true;
 
   bool operator==(const ShadowConfig&) const = default;
 };
@@ -403,6 +406,7 @@ void visit(V& v, ShadowConfig& s) {
   v.key("receiver_height_m", s.receiver_height_m, "world z of the real ground");
   v.key("light_angular_diameter_deg", s.light_angular_diameter_deg, NumberRange::closed_open(0, 90).in("degrees"),
         "size of the fixed light (pcss); estimates bring their own");
+  v.key("sky_occlusion", s.sky_occlusion, "the objects also hide ambient light from the real surfaces beside them");
 }
 
 // The precomputed radiance transfer bake (render/prt): run once per mesh and kept in a cache

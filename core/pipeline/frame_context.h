@@ -13,6 +13,7 @@
 #include "core/geometry/se3.h"
 #include "core/light/light_estimate.h"
 #include "core/motion/shutter_motion.h"
+#include "core/pipeline/object_report.h"
 
 namespace arpipe {
 
@@ -86,6 +87,9 @@ struct FrameContext {
   // How the virtual layer was drawn: "off" (sharp) or the render.blur method used, and its samples.
   std::string blur_method = "off";
   int blur_samples = 0;
+  // Per virtual object, where it is and how much the proxies hid (the render stage; empty unless
+  // the config has proxies or physics).
+  std::vector<ObjectReport> objects;
   std::vector<StageTiming> timings;
   uint64_t input_index = 0;                     // position in the stream as the pipeline saw it
   uint64_t dropped_before = 0;                  // frames lost just before this one (sequence gap or queue drop)

@@ -3,6 +3,9 @@
 
 #include <fmt/format.h>
 
+#include <cctype>
+#include <string>
+
 namespace arpipe {
 namespace {
 
@@ -142,7 +145,40 @@ float shadow_visibility(vec3 world) {
 
 }  // namespace
 
-std::string shadow_lookup_glsl(ShadowMethod method) {
+namespace {
+
+// Every name the lookups declare, so that a second copy can live beside the first under a prefix.
+constexpr std::string_view kLookupNames[] = {
+    "u_shadow_map", "u_shadow_clip_from_world", "u_shadow_depth_plane", "u_shadow_local", "u_shadow_near",
+    "u_shadow_range", "u_shadow_texel", "u_shadow_bias", "u_pcf_radius", "u_penumbra_per_depth", "u_max_search",
+    "u_vsm_min_variance", "u_vsm_bleed", "shadow_coordinates", "outside_map", "lit_at", "receiver_depth_gradient",
+    "penumbra_radius", "shadow_visibility", "chebyshev", "unpack_moments"};
+
+bool identifier_char(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
+
+// Each whole-word occurrence of the lookup's names gets the prefix.
+std::string prefixed(const std::string& source, std::string_view prefix) {
+  std::string out;
+  out.reserve(source.size() + 1024);
+  size_t i = 0;
+  while (i < source.size()) {
+    bool replaced = false;
+    if (!identifier_char(source[i]) || i == 0 || !identifier_char(source[i - 1]))
+      for (std::string_view name : kLookupNames)
+        if (source.compare(i, name.size(), name) == 0 &&
+            (i + name.size() == source.size() || !identifier_char(source[i + name.size()]))) {
+          out += prefix;
+          out += name;
+          i += name.size();
+          replaced = true;
+          break;
+        }
+    if (!replaced) out += source[i++];
+  }
+  return out;
+}
+
+std::string lookup_source(ShadowMethod method) {
   switch (method) {
     case ShadowMethod::Off: return "float shadow_visibility(vec3 world) { return 1.0; }\n";
     case ShadowMethod::Hard: return std::string(kCommon) + std::string(kHard);
@@ -154,16 +190,25 @@ std::string shadow_lookup_glsl(ShadowMethod method) {
   return {};
 }
 
-void set_shadow_lookup_uniforms(const GlProgram& program, const ShadowLookup& lookup, int texture_unit) {
+}  // namespace
+
+std::string shadow_lookup_glsl(ShadowMethod method, std::string_view prefix) {
+  const std::string source = lookup_source(method);
+  return prefix.empty() ? source : prefixed(source, prefix);
+}
+
+void set_shadow_lookup_uniforms(const GlProgram& program, const ShadowLookup& lookup, int texture_unit,
+                                std::string_view prefix) {
   if (lookup.method == ShadowMethod::Off) return;
+  const auto name = [&](const char* n) { return std::string(prefix) + n; };
   glActiveTexture(static_cast<GLenum>(GL_TEXTURE0 + texture_unit));
   glBindTexture(GL_TEXTURE_2D, lookup.texture);
-  glUniform1i(program.uniform("u_shadow_map"), texture_unit);
-  glUniformMatrix4fv(program.uniform("u_shadow_clip_from_world"), 1, GL_FALSE, lookup.clip_from_world.data());
-  glUniform4fv(program.uniform("u_shadow_depth_plane"), 1, lookup.depth_plane.data());
+  glUniform1i(program.uniform(name("u_shadow_map").c_str()), texture_unit);
+  glUniformMatrix4fv(program.uniform(name("u_shadow_clip_from_world").c_str()), 1, GL_FALSE, lookup.clip_from_world.data());
+  glUniform4fv(program.uniform(name("u_shadow_depth_plane").c_str()), 1, lookup.depth_plane.data());
   // The compiler drops the uniforms a method does not read; only those it reads are set.
-  const auto set = [&](const char* name, float value) {
-    const GLint location = glGetUniformLocation(program.id(), name);
+  const auto set = [&](const char* n, float value) {
+    const GLint location = glGetUniformLocation(program.id(), name(n).c_str());
     if (location >= 0) glUniform1f(location, value);
   };
   set("u_shadow_texel", lookup.texel);
@@ -176,48 +221,6 @@ void set_shadow_lookup_uniforms(const GlProgram& program, const ShadowLookup& lo
   set("u_max_search", lookup.max_search_texels);
   set("u_vsm_min_variance", lookup.vsm_min_variance);
   set("u_vsm_bleed", lookup.vsm_bleed_reduction);
-  glActiveTexture(GL_TEXTURE0);
-}
-
-namespace {
-
-// Non-uniform control flow is fine here: textureLod takes no derivatives.
-constexpr std::string_view kRealShadow = R"glsl(
-uniform bool u_real_shadow;
-uniform highp sampler2D u_real_map;
-uniform mat4 u_real_clip_from_world;
-uniform vec4 u_real_depth_plane;
-uniform float u_real_texel;
-uniform float u_real_bias;
-float real_shadow_visibility(vec3 world) {
-  if (!u_real_shadow) return 1.0;
-  vec4 clip = u_real_clip_from_world * vec4(world, 1.0);
-  vec3 p = vec3(clip.xy / clip.w * 0.5 + 0.5, dot(u_real_depth_plane, vec4(world, 1.0)));
-  if (any(lessThan(p.xy, vec2(0.0))) || any(greaterThan(p.xy, vec2(1.0))) || p.z >= 1.0) return 1.0;
-  float sum = 0.0;
-  for (int y = -1; y <= 1; ++y)
-    for (int x = -1; x <= 1; ++x)
-      sum += p.z - u_real_bias <= textureLod(u_real_map, p.xy + vec2(x, y) * u_real_texel, 0.0).r ? 1.0 : 0.0;
-  return sum / 9.0;
-}
-)glsl";
-
-}  // namespace
-
-std::string real_shadow_lookup_glsl() { return std::string(kRealShadow); }
-
-void set_real_shadow_uniforms(const GlProgram& program, const ShadowLookup* lookup, int texture_unit) {
-  glUniform1i(program.uniform("u_real_shadow"), lookup ? 1 : 0);
-  if (!lookup) return;
-  glActiveTexture(static_cast<GLenum>(GL_TEXTURE0 + texture_unit));
-  glBindTexture(GL_TEXTURE_2D, lookup->texture);
-  glUniform1i(program.uniform("u_real_map"), texture_unit);
-  glUniformMatrix4fv(program.uniform("u_real_clip_from_world"), 1, GL_FALSE, lookup->clip_from_world.data());
-  glUniform4fv(program.uniform("u_real_depth_plane"), 1, lookup->depth_plane.data());
-  glUniform1f(program.uniform("u_real_texel"), lookup->texel);
-  // Twice the map's own bias: a real surface is both caster and receiver in this map, so acne
-  // would show as a false real shadow that cancels a virtual one.
-  glUniform1f(program.uniform("u_real_bias"), 2 * lookup->bias);
   glActiveTexture(GL_TEXTURE0);
 }
 

@@ -201,7 +201,8 @@ TEST_F(ArpipeCli, VersionAndHelpOfEveryCommand) {
   EXPECT_EQ(out.rfind("arpipe 0.", 0), 0u) << out;  // the CMake project version, then git describe
   ASSERT_EQ(run({"--help"}, &out, &err), 0) << err;
   const std::vector<std::string> commands{"inspect", "replay", "simulate", "calib",  "board",  "bench", "sh",
-                                          "bake",    "sun",    "cameras",  "record", "config", "ctl"};
+                                          "bake",    "sun",    "cameras",  "record", "config", "ctl",
+                                          "proxy"};
   for (const std::string& command : commands) {
     EXPECT_NE(out.find("  " + command + " "), std::string::npos) << command << "\n" << out;
     std::string help;

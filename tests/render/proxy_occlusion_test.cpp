@@ -167,6 +167,39 @@ TEST(Proxies, HideTheCubeBehindThemAtPixelCentres) {
   EXPECT_GT(seen_without, visible + 300);
 }
 
+// The frame's report says how much of the cube the carton hid, and by name: against the share of
+// the cube's own 8 x 8 subpixel samples that the carton hides, within the meter's 24 x 24 ray
+// grid's sampling error (about 0.03 for a few hundred rays on the cube).
+TEST(Proxies, TheFrameSaysHowMuchOfEachObjectIsHiddenAndByWhat) {
+  harness().configure(proxy_config(4, ProxyRoles{}));
+  const SE3 pose = oblique_pose();
+  FrameContext ctx = make_context(black_frame(), pinhole_camera(), pose);
+  harness().process(ctx);
+  ASSERT_EQ(ctx.objects.size(), 1u);
+  const ObjectReport& report = ctx.objects[0];
+  EXPECT_TRUE(report.in_view);
+  EXPECT_TRUE(report.present);
+  // The truth: samples that meet the cube, and of those the ones the carton is in front of.
+  const SE3 T_world_cam = pose.inverse();
+  int on_cube = 0, hidden = 0;
+  for (int y = 0; y < kHeight * 4; ++y)
+    for (int x = 0; x < kWidth * 4; ++x) {
+      const std::optional<Vec3> ray = ctx.camera_model->unproject({(x + 0.5) / 4 - 0.5, (y + 0.5) / 4 - 0.5});
+      const std::optional<double> cube = entry_distance(T_world_cam, kCube, *ray);
+      if (!cube) continue;
+      ++on_cube;
+      const std::optional<double> carton = entry_distance(T_world_cam, kProxy, *ray);
+      hidden += carton && *carton < *cube;
+    }
+  const double truth = double(hidden) / on_cube;
+  std::cout << "hidden " << report.hidden << ", truth " << truth << "\n";
+  EXPECT_GT(truth, 0.3);
+  EXPECT_NEAR(report.hidden, truth, 0.03);
+  ASSERT_EQ(report.hidden_by.size(), 1u);
+  EXPECT_EQ(report.hidden_by[0].first, "carton");
+  EXPECT_EQ(report.hidden_by[0].second, report.hidden);
+}
+
 // With 4x multisampling the occlusion edge is antialiased like the cube's own: the mean
 // displacement of the whole visible outline (symmetric difference of the coverage masks over the
 // edge length) stays far under issue 22's 0.5 px for a still frame.

@@ -120,7 +120,7 @@ TEST(ProxiesConfig, RefusesBadRowsNamingThePlace) {
                      {"p.toml:2", "render.proxies[0].roles", "\"ocluded\"", "\"receive_shadows\""});
   expect_proxy_error("[[render.proxies]]\nroles = [\"collide\", \"collide\"]\n", {"render.proxies[0].roles", "twice"});
   expect_proxy_error("[[render.proxies]]\nroles = \"occlude\"\n", {"render.proxies[0].roles", "an array"});
-  expect_proxy_error("[[render.proxies]]\nsize_m = [0.1, 0, 0.1]\n", {"render.proxies[0].size_m"});
+  expect_proxy_error("[[render.proxies]]\nsize_m = [0.1, -0.01, 0.1]\n", {"render.proxies[0].size_m"});
   expect_proxy_error("[[render.proxies]]\ncollider = \"mesh\"\n", {"render.proxies[0].collider", "\"triangles\""});
   expect_proxy_error("[[render.proxies]]\nmesh = \"\"\n", {"render.proxies[0].mesh"});
   expect_proxy_error("[[render.proxies]]\nwhatever = 1\n", {"render.proxies[0].whatever", "unknown key"});

@@ -1,0 +1,25 @@
+// What the render stage says about each virtual object of a frame, for results.jsonl and /state:
+// where it is (it may move by physics), whether it is still in the world, and how much of it the
+// phantom proxies hid, and which.
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/geometry/vec.h"
+
+namespace arpipe {
+
+struct ObjectReport {
+  int index = 0;                 // in render.objects
+  Vec3 position_m{0, 0, 0};      // the object's origin in the world at mid-exposure
+  bool present = true;           // false once the physics removed it (it left the world)
+  bool in_view = false;          // its box reaches into the picture
+  // Of the object's own pixels (rays that meet it), the share behind a proxy that occludes, in
+  // all and per proxy (by name, the nearest one in front). Measured when in view; 0 otherwise.
+  double hidden = 0;
+  std::vector<std::pair<std::string, double>> hidden_by;
+};
+
+}  // namespace arpipe
