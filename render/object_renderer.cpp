@@ -60,7 +60,6 @@ uniform float u_specular;        // its weight
 uniform vec3 u_camera_world;     // the eye, for the reflection direction
 uniform float u_exposure_scale;
 uniform bool u_shadow_catcher;
-uniform bool u_proxy;            // real geometry: depth only, or the catcher's darkening
 out vec4 out_color;              // linear, premultiplied alpha
 {shadow_lookup}
 {real_shadow_lookup}
@@ -115,10 +114,6 @@ void main() {{
     out_color = vec4(0.0, 0.0, 0.0, 1.0 - ratio);
     return;
   }}
-  if (u_proxy) {{
-    out_color = vec4(0.0);
-    return;
-  }}
   vec3 environment = u_prt ? v_prt_radiance : ambient_at(normal);
   vec3 rgb = u_base_color.rgb * max(environment + u_light_color * (lambert * visibility), 0.0);
   if (u_specular > 0.0) {{
@@ -129,6 +124,19 @@ void main() {{
   rgb *= u_exposure_scale;
   out_color = vec4(rgb * u_base_color.a, u_base_color.a);
 }}
+)glsl";
+
+// A proxy that only hides: its depth and a transparent layer, nothing shaded (the shading
+// program would run its shadow lookups for pixels that show the camera anyway).
+constexpr std::string_view kOccluderVertexShader = R"glsl(
+layout(location = 0) in vec3 a_position;
+void main() { gl_Position = camera_to_clip(pose_camera_point(a_position)); }
+)glsl";
+
+constexpr std::string_view kOccluderFragmentShader = R"glsl(#version 300 es
+precision mediump float;
+out vec4 out_color;
+void main() { out_color = vec4(0.0); }
 )glsl";
 
 constexpr std::string_view kVelocityVertexShader = R"glsl(
@@ -208,7 +216,8 @@ void set_depth_state() {
 }  // namespace
 
 ObjectRenderer::ObjectRenderer()
-    : velocity_("object velocity", vertex_source({"mid", "start", "end"}, kVelocityVertexShader), kVelocityFragmentShader) {
+    : velocity_("object velocity", vertex_source({"mid", "start", "end"}, kVelocityVertexShader), kVelocityFragmentShader),
+      occluder_("proxy occluder", vertex_source({"pose"}, kOccluderVertexShader), kOccluderFragmentShader) {
   prepare(ShadowMethod::Off);
 }
 
@@ -234,6 +243,13 @@ void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, c
   const ShadowMethod method = lighting.shadow ? lighting.shadow->method : ShadowMethod::Off;
   const GlProgram& program = shading(method);
   set_depth_state();
+  const bool any_occluder = std::any_of(objects.begin(), objects.end(), [](const ObjectAtInstant& item) {
+    return item.object->proxy && !item.object->shadow_catcher;
+  });
+  if (any_occluder) {
+    set_lens_uniforms(occluder_, lens);
+    set_row_projection(occluder_, rows);
+  }
   set_lens_uniforms(program, lens);  // binds the program
   set_row_projection(program, rows);
   set_vec3(program.uniform("u_light_direction"), lighting.direction);
@@ -264,19 +280,25 @@ void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, c
   const GLint object_scale = program.uniform("u_object_scale");
   const GLint base_color = program.uniform("u_base_color");
   const GLint shadow_catcher = program.uniform("u_shadow_catcher");
-  const GLint proxy = program.uniform("u_proxy");
   const GLint prt = program.uniform("u_prt");
   const GLint specular = program.uniform("u_specular");
   const GLint camera_world = program.uniform("u_camera_world");
   const GLint prt_light = program.uniform("u_prt_light");
   for (const ObjectAtInstant& item : objects) {
+    if (item.object->proxy && !item.object->shadow_catcher) {
+      glUseProgram(occluder_.id());
+      set_row_poses(occluder_, "pose", item.poses, item.object->scale);
+      glDepthMask(item.object->writes_depth ? GL_TRUE : GL_FALSE);
+      item.object->mesh->draw([](const MeshPart&) {});
+      glUseProgram(program.id());
+      continue;
+    }
     set_row_poses(program, "pose", item.poses, item.object->scale);
     const std::array<float, 9> rotation = column_major(item.object->T_world_object.rotation());
     glUniformMatrix3fv(world_from_object_rotation, 1, GL_FALSE, rotation.data());
     set_vec3(world_from_object_translation, item.object->T_world_object.translation());
     glUniform1f(object_scale, static_cast<float>(item.object->scale));
     glUniform1i(shadow_catcher, item.object->shadow_catcher ? 1 : 0);
-    glUniform1i(proxy, item.object->proxy ? 1 : 0);
     glDepthMask(item.object->writes_depth ? GL_TRUE : GL_FALSE);
     glUniform1f(specular, item.object->shadow_catcher || item.object->proxy ? 0.0f : static_cast<float>(item.object->specular));
     if (item.object->specular > 0 && !item.poses.T_cam_object.empty()) {

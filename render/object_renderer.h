@@ -77,6 +77,7 @@ class ObjectRenderer {
   const GlProgram& shading(ShadowMethod method);
   std::map<ShadowMethod, GlProgram> shading_;  // one per shadow lookup
   GlProgram velocity_;
+  GlProgram occluder_;  // proxies that hide but catch no shadow: depth only
 };
 
 }  // namespace arpipe

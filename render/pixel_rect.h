@@ -25,6 +25,13 @@ struct PixelRect {
     const int left = std::min(x, other.x), top = std::min(y, other.y);
     return {left, top, std::max(right(), other.right()) - left, std::max(bottom(), other.bottom()) - top};
   }
+  // The rectangle both cover; empty when they do not meet.
+  PixelRect intersected(const PixelRect& other) const {
+    const int left = std::max(x, other.x), top = std::max(y, other.y);
+    const int r = std::min(right(), other.right()), b = std::min(bottom(), other.bottom());
+    if (r <= left || b <= top) return {};
+    return {left, top, r - left, b - top};
+  }
   bool operator==(const PixelRect&) const = default;
 };
 

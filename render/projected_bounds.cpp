@@ -38,8 +38,18 @@ std::optional<PixelRect> projected_box_rect(const CameraModel& camera, const SE3
       const Vec3& to = corners[static_cast<size_t>(a | bit)];
       for (int s = 0; s <= kSamplesPerEdge; ++s) points.push_back(from + (double(s) / kSamplesPerEdge) * (to - from));
     }
+  return projected_points_rect(camera, points, margin_px);
+}
+
+std::optional<PixelRect> projected_points_rect(const CameraModel& camera, const std::vector<Vec3>& points_cam,
+                                               double margin_px) {
+  const PixelRect image = PixelRect::full(camera.width(), camera.height());
+  size_t behind = 0;
+  for (const Vec3& p : points_cam) behind += p[2] <= kNearPlaneM;
+  if (points_cam.empty() || behind == points_cam.size()) return std::nullopt;
+  if (behind > 0) return image;
   std::vector<Vec2> pixels;
-  camera.project(points, pixels);
+  camera.project(points_cam, pixels);
 
   double min_u = INFINITY, min_v = INFINITY, max_u = -INFINITY, max_v = -INFINITY;
   for (const Vec2& pixel : pixels) {

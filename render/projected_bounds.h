@@ -3,6 +3,7 @@
 #pragma once
 
 #include <optional>
+#include <vector>
 
 #include "core/geometry/camera_model.h"
 #include "core/geometry/se3.h"
@@ -17,5 +18,11 @@ namespace arpipe {
 // nullopt when it lies wholly behind the near plane or outside the image.
 std::optional<PixelRect> projected_box_rect(const CameraModel& camera, const SE3& T_cam_object, const Bounds& box,
                                             double margin_px);
+
+// The same for any set of camera-frame points (a shape's edges, sampled densely enough for the
+// lens's bend): their bounding rectangle, widened, clipped; the whole image when some lie behind
+// the near plane and others in front; nullopt when all lie behind or it misses the image.
+std::optional<PixelRect> projected_points_rect(const CameraModel& camera, const std::vector<Vec3>& points_cam,
+                                               double margin_px);
 
 }  // namespace arpipe

@@ -260,8 +260,9 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
   for (const UploadedObject& object : objects_)
     if (object.present && rect_of(object, rect)) request.objects.push_back(&object);
   if (request.objects.empty()) return Drawn::OutOfView;
-  // Proxies in view: those that receive shadows but hide nothing go first, without depth, so
-  // that the objects cover them; those that hide go after the objects.
+  // Proxies in view go first: those that hide write their depth, so that the objects' fragments
+  // behind them fail the depth test before they are shaded; then those that receive shadows but
+  // hide nothing, without depth, so that the objects cover them.
   std::vector<const UploadedObject*> receivers_first, occluders;
   PixelRect proxy_receivers;
   for (const UploadedObject& proxy : proxies_) {
@@ -272,7 +273,7 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
     (proxy.writes_depth ? occluders : receivers_first).push_back(&proxy);
   }
   request.objects.insert(request.objects.begin(), receivers_first.begin(), receivers_first.end());
-  request.objects.insert(request.objects.end(), occluders.begin(), occluders.end());
+  request.objects.insert(request.objects.begin(), occluders.begin(), occluders.end());
   session_->make_current();
 
   // "map": draw on the pinhole canvas, in the part of it that the output rectangle samples.
@@ -294,7 +295,18 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
   if (request.lighting.shadow) {
     // Proxies that catch the shadow join the footprint (their whole box: the shadow's place on
     // them is not known here), and so does the ground catcher's patch.
-    rect = rect.united(proxy_receivers);
+    if (!proxy_receivers.empty()) {
+      // Only where the objects' shadows can reach them.
+      const std::vector<SE3> seen_from{instants.front().T_cam_world, instants[instants.size() / 2].T_cam_world,
+                                       instants.back().T_cam_world};
+      PixelRect shadows;
+      for (const SE3& T_cam_world : seen_from) {
+        const std::optional<PixelRect> r = shadow_volume_rect(image_camera, T_cam_world, request.lighting);
+        // Unbounded (a grazing light): every receiving proxy in view, whole.
+        shadows = shadows.united(r ? *r : PixelRect::full(camera.width(), camera.height()));
+      }
+      rect = rect.united(proxy_receivers.intersected(shadows));
+    }
     const UploadedObject& catcher = *request.objects.back();
     for (const SE3& T_cam_world : exposure_poses)
       if (std::optional<PixelRect> r =
@@ -423,7 +435,24 @@ const ShadowLookup* RenderStage::shadow_for(FrameContext& ctx, Lighting& lightin
           ? fit_local_shadow_frustum(lighting.position, casters, settings_.shadows.receiver_height_m, margin)
           : fit_shadow_frustum(shadow_light_direction_, casters, settings_.shadows.receiver_height_m, margin);
   if (!frustum) return skip(lighting.local ? "lamp not above the objects" : "light below the ground");
-  const UploadedObject& catcher = receiver_->over(frustum->receiver);
+  // The ground catcher covers where the virtual objects' shadows fall; the real casters' own
+  // shadows are in the picture already, so they widen the map but not the catcher.
+  ReceiverPatch patch = frustum->receiver;
+  if (!real_casters.empty()) {
+    const std::vector<ShadowCaster> virtual_casters(casters.begin(), casters.end() - long(real_casters.size()));
+    const std::optional<ShadowFrustum> virtual_only =
+        lighting.local ? fit_local_shadow_frustum(lighting.position, virtual_casters, settings_.shadows.receiver_height_m, margin)
+                       : fit_shadow_frustum(shadow_light_direction_, virtual_casters, settings_.shadows.receiver_height_m, margin);
+    if (virtual_only) patch = virtual_only->receiver;
+  }
+  // And where they hide the sky from the ground: a sphere of radius r whose centre stands c above
+  // the ground hides r^2 c / d^3 of it at distance d, about 1 % at d = 4 r.
+  for (const std::array<float, 4>& sphere : lighting.sky_occluders)
+    for (size_t axis = 0; axis < 2; ++axis) {
+      patch.min[axis] = std::min(patch.min[axis], double(sphere[axis]) - 4.0 * sphere[3]);
+      patch.max[axis] = std::max(patch.max[axis], double(sphere[axis]) + 4.0 * sphere[3]);
+    }
+  const UploadedObject& catcher = receiver_->over(patch);
   // Variance maps also hold the ground, so that filtering across an object's edge blends its depth
   // with the ground's rather than with empty space.
   if (is_variance_method(settings_.shadow_method)) caster_objects.push_back(&catcher);
@@ -465,6 +494,41 @@ bool RenderStage::move_objects(const ShutterMotion& motion) {
     };
   }
   return moved;
+}
+
+std::optional<PixelRect> RenderStage::shadow_volume_rect(const CameraModel& camera, const SE3& T_cam_world,
+                                                        const Lighting& lighting) const {
+  // Each object's shadow lies in the hull of its box and the box's projection onto the ground
+  // along the light: their edges and the segments joining them, sampled for the lens's bend, with
+  // the ground copy also shifted by the penumbra's reach.
+  constexpr int kSamples = 8;
+  const double h = settings_.shadows.receiver_height_m;
+  std::vector<Vec3> points;
+  for (const UploadedObject& object : objects_) {
+    if (!object.present) continue;
+    const std::array<Vec3, 8> local = box_corners(object.bounds);
+    std::array<Vec3, 8> top{}, ground{};
+    const double reach = norm(object.bounds.max - object.bounds.min) * 0.1 + 0.01;
+    for (size_t i = 0; i < 8; ++i) {
+      top[i] = object.T_world_object * local[i];
+      const Vec3 towards = lighting.local ? normalized(lighting.position - top[i]) : lighting.direction;
+      if (towards[2] < 0.05) return std::nullopt;  // grazing light: the shadow runs far
+      ground[i] = top[i] - ((top[i][2] - h) / towards[2]) * towards;
+    }
+    const auto add_segment = [&](const Vec3& a, const Vec3& b) {
+      for (int s = 0; s <= kSamples; ++s) points.push_back(T_cam_world * (a + (double(s) / kSamples) * (b - a)));
+    };
+    for (size_t a = 0; a < 8; ++a) {
+      add_segment(top[a], ground[a]);
+      for (size_t bit = 1; bit < 8; bit <<= 1) {
+        if (a & bit) continue;
+        add_segment(top[a], top[a | bit]);
+        for (const Vec3& shift : {Vec3{reach, 0, 0}, Vec3{-reach, 0, 0}, Vec3{0, reach, 0}, Vec3{0, -reach, 0}})
+          add_segment(ground[a] + shift, ground[a | bit] + shift);
+      }
+    }
+  }
+  return projected_points_rect(camera, points, kRectMarginPx);
 }
 
 double RenderStage::moving_objects_motion_px(const ShutterMotion& motion, const CameraModel& camera) const {

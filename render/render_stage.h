@@ -4,6 +4,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -79,6 +80,10 @@ class RenderStage final : public Stage {
   // Steps the physics to the frame's exposure end and places the moving objects at its middle;
   // whether any of them moved since the last frame.
   bool move_objects(const ShutterMotion& motion);
+  // Where the objects' shadows can fall in the image (their boxes' shadow volumes down to the
+  // ground); nullopt when it cannot be bounded (a grazing light).
+  std::optional<PixelRect> shadow_volume_rect(const CameraModel& camera, const SE3& T_cam_world,
+                                              const Lighting& lighting) const;
   // The largest image motion of a moving object's box corners over the exposure (its own blur).
   double moving_objects_motion_px(const ShutterMotion& motion, const CameraModel& camera) const;
   std::shared_ptr<const LensWarpMap> warp_map(const std::shared_ptr<const CameraModel>& camera_model);

@@ -24,10 +24,12 @@ std::string config_name(const Config& config) {
 
 // Errors name the config key as well as the file (the message from the loader names the file and
 // the place in it).
-// key: "render.objects[2].mesh". Sized builtins (builtin:box, ...) are made at size_m.
-Mesh load_mesh(const Config& config, const std::string& key, const std::string& source, const Vec3& size_m = {0.06, 0.06, 0.06}) {
+// key: "render.objects[2].mesh". Sized builtins (builtin:box, ...) are made at size_m with their
+// faces split subdivisions x subdivisions.
+Mesh load_mesh(const Config& config, const std::string& key, const std::string& source,
+               const Vec3& size_m = {0.06, 0.06, 0.06}, int subdivisions = 8) {
   if (is_builtin_mesh_source(source)) {
-    if (auto mesh = make_builtin_mesh(source, size_m)) return std::move(*mesh);
+    if (auto mesh = make_builtin_mesh(source, size_m, subdivisions)) return std::move(*mesh);
     throw ConfigError(fmt::format("{}: {}: unknown builtin mesh \"{}\" (expected "
                                   "{} or a glTF 2.0 file)",
                                   config_name(config), key, source, kBuiltinMeshNames));
@@ -40,9 +42,12 @@ Mesh load_mesh(const Config& config, const std::string& key, const std::string& 
 }
 
 // A proxy's mesh must have triangles: one without hides and catches nothing, which is never meant.
+// A proxy is never shaded, so a builtin's faces are split only where the lens is applied per
+// vertex (render.lens = "vertex": long edges must bend with it); otherwise a box is 12 triangles,
+// which matters on a software rasteriser (about a microsecond per triangle drawn).
 std::shared_ptr<const Mesh> load_proxy_mesh(const Config& config, const std::string& key, const std::string& source,
                                             const Vec3& size_m) {
-  Mesh mesh = load_mesh(config, key, source, size_m);
+  Mesh mesh = load_mesh(config, key, source, size_m, config.render.lens == LensMode::Vertex ? 8 : 1);
   if (mesh.triangle_count() == 0)
     throw AssetError(fmt::format("{}: {} = \"{}\": the mesh has no triangles", config_name(config), key, source));
   return std::make_shared<const Mesh>(std::move(mesh));

@@ -227,11 +227,12 @@ bool builtin_mesh_is_sized(std::string_view source) {
   return source == "builtin:box" || source == "builtin:cylinder" || source == "builtin:plane";
 }
 
-std::optional<Mesh> make_builtin_mesh(std::string_view source, const Vec3& size_m) {
+std::optional<Mesh> make_builtin_mesh(std::string_view source, const Vec3& size_m, int subdivisions) {
+  subdivisions = std::max(subdivisions, 1);
   std::optional<Mesh> mesh;
-  if (source == "builtin:box") mesh = make_box_mesh(size_m);
-  else if (source == "builtin:cylinder") mesh = make_cylinder_mesh(size_m);
-  else if (source == "builtin:plane") mesh = make_rectangle_mesh(size_m[0], size_m[1]);
+  if (source == "builtin:box") mesh = make_box_mesh(size_m, subdivisions);
+  else if (source == "builtin:cylinder") mesh = make_cylinder_mesh(size_m, 48, subdivisions);
+  else if (source == "builtin:plane") mesh = make_rectangle_mesh(size_m[0], size_m[1], subdivisions);
   else return make_builtin_mesh(source);
   mesh->source = std::string(source);
   return mesh;

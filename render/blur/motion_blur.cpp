@@ -94,11 +94,14 @@ LayerDrawResult MotionBlurDrawer::draw_accumulated(VirtualLayer& layer, const La
 LayerDrawResult MotionBlurDrawer::draw_intraframe_warp(VirtualLayer& layer, const LayerDrawRequest& request, int fixed_samples) {
   // The box corners of every object, tracked on the canvas: one affine warp serves all objects,
   // which is exact for one object and close for objects near each other.
+  // Proxies stand still in the world like the ground; their (often large, near) boxes would pull
+  // the one warp away from the objects' own motion, so only the rest are tracked.
   const CornerTrack corners_at = [&](double t) {
     std::vector<std::optional<Vec2>> out;
     for (const ObjectAtInstant& item : objects_at(request, t))
-      for (const Vec3& corner : box_corners(item.object->bounds))
-        out.push_back(request.canvas_camera->project(item.poses.camera_point(corner, request.rows)));
+      if (!item.object->proxy)
+        for (const Vec3& corner : box_corners(item.object->bounds))
+          out.push_back(request.canvas_camera->project(item.poses.camera_point(corner, request.rows)));
     return out;
   };
   const IntraframeWarpPlan plan = plan_intraframe_warp_blur(corners_at, fixed_samples);
