@@ -58,7 +58,10 @@ ShadowScene sun_outdoor_shadow_scene() {
           look_at({0.08, -0.50, 0.45}, {0.02, 0.05, 0.0}), {0.0, 0.25, -0.25, 0.05}};
 }
 
-Config shadow_config(const ShadowScene& scene, const std::string& method_and_kernel, int map_size) {
+Config shadow_config(const ShadowScene& scene, const std::string& method_kernel_sky, int map_size) {
+  // "pcss+sky": with render.shadows.sky_occlusion.
+  const bool sky = method_kernel_sky.size() > 4 && method_kernel_sky.ends_with("+sky");
+  const std::string method_and_kernel = sky ? method_kernel_sky.substr(0, method_kernel_sky.size() - 4) : method_kernel_sky;
   // "pcf:8": the method, and the PCF kernel after a colon.
   const size_t colon = method_and_kernel.find(':');
   const std::string method_name = method_and_kernel.substr(0, colon);
@@ -80,6 +83,7 @@ Config shadow_config(const ShadowScene& scene, const std::string& method_and_ker
   config.render.light_color = (1 / std::numbers::pi) * scene.direct;
   config.render.ambient = (1 / std::numbers::pi) * scene.ambient;
   config.render.shadows.method = *method;
+  config.render.shadows.sky_occlusion = sky;
   config.render.shadows.map_size = map_size;
   config.render.shadows.receiver_height_m = -0.0005;
   config.render.shadows.light_angular_diameter_deg = scene.light_diameter_rad * 180 / std::numbers::pi;

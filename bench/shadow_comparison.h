@@ -33,7 +33,8 @@ struct ShadowScene {
 ShadowScene probe_indoor_shadow_scene();
 ShadowScene sun_outdoor_shadow_scene();
 
-// method: a render.shadows.method, optionally with the PCF kernel after a colon ("pcf:8").
+// method: a render.shadows.method, optionally with the PCF kernel after a colon ("pcf:8") and
+// "+sky" for render.shadows.sky_occlusion ("pcss+sky").
 Config shadow_config(const ShadowScene& scene, const std::string& method, int map_size = 1024);
 
 struct ShadowTruth {

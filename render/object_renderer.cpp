@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
+#include <functional>
 
 #include "core/sh/sh_rotation.h"
 #include "render/shadow/shadow_lookup_glsl.h"
@@ -67,6 +69,8 @@ uniform bool u_real_shadow;    // a map of the real casters alone is bound
 // The virtual objects as spheres of their mean projected area (xyz: centre, world; w: radius).
 uniform int u_sky_occluder_count;
 uniform vec4 u_sky_occluders[{max_sky_occluders}];
+uniform vec4 u_catcher_patch;    // the ground catcher's square: x, y min and max (world)
+uniform bool u_ground_catcher;   // this draw is that square (not a proxy)
 
 vec3 sh9_at(vec3 c[9], vec3 n) {{
   return 0.282095 * c[0] + 0.488603 * (n.y * c[1] + n.z * c[2] + n.x * c[3])
@@ -109,7 +113,14 @@ void main() {{
     float ambient = max(dot(ambient_at(normal), luma), 0.0);
     float direct = dot(u_light_color, luma) * lambert;
     float real_direct = direct * real_visibility;
-    float lit = ambient * (1.0 - sky_occlusion(v_world, normal, ambient)) + visibility * direct;
+    float occlusion = sky_occlusion(v_world, normal, ambient);
+    if (u_ground_catcher) {{
+      // Faded out over the last tenth of the square's half-width, so that its edge shows no step.
+      vec2 inside = min(v_world.xy - u_catcher_patch.xy, u_catcher_patch.zw - v_world.xy);
+      float fade_width = 0.1 * max(0.5 * (u_catcher_patch.z - u_catcher_patch.x), 1e-6);
+      occlusion *= clamp(min(inside.x, inside.y) / fade_width, 0.0, 1.0);
+    }}
+    float lit = ambient * (1.0 - occlusion) + visibility * direct;
     float ratio = ambient + real_direct > 0.0 ? min(lit / (ambient + real_direct), 1.0) : 1.0;
     out_color = vec4(0.0, 0.0, 0.0, 1.0 - ratio);
     return;
@@ -238,8 +249,47 @@ const GlProgram& ObjectRenderer::shading(ShadowMethod method) {
   return found->second;
 }
 
+namespace {
+
+// Whether a cluster's box (object frame, scaled) can reach into the rectangle at any of the item's
+// row poses, through the pinhole canvas; a box reaching behind the near plane, or a lens applied
+// per vertex, counts as in.
+bool cluster_in_rect(const Bounds& box, const RowPoses& poses, const LensUniforms& lens, const PixelRect& rect) {
+  if (lens.distorted) return true;
+  constexpr double kMarginPx = 2.0;
+  const auto [fx, fy, cx, cy] = lens.focal_center;
+  for (const SE3& T_cam_object : poses.T_cam_object) {
+    double u0 = INFINITY, u1 = -INFINITY, v0 = INFINITY, v1 = -INFINITY;
+    for (const Vec3& corner : box_corners(box)) {
+      const Vec3 p = T_cam_object * corner;
+      if (p[2] <= kNearPlaneM) return true;
+      const double u = fx * p[0] / p[2] + cx, v = fy * p[1] / p[2] + cy;
+      u0 = std::min(u0, u), u1 = std::max(u1, u), v0 = std::min(v0, v), v1 = std::max(v1, v);
+    }
+    if (u1 + kMarginPx >= rect.x - 0.5 && u0 - kMarginPx <= rect.right() - 0.5 && v1 + kMarginPx >= rect.y - 0.5 &&
+        v0 - kMarginPx <= rect.bottom() - 0.5)
+      return true;
+  }
+  return false;
+}
+
+// Draws the object's mesh: whole, or the clusters of a large proxy that reach into the rectangle.
+void draw_mesh(const ObjectAtInstant& item, const LensUniforms& lens, const PixelRect& cull_rect,
+               const std::function<void(const MeshPart&)>& before_part) {
+  const UploadedObject& object = *item.object;
+  if (object.cluster_bounds.empty() || object.cluster_bounds.size() != object.mesh->part_count()) {
+    object.mesh->draw(before_part);
+    return;
+  }
+  // Clusters share the proxy's one colour: set it once.
+  before_part(MeshPart{0, 0, object.base_color ? *object.base_color : std::array<float, 4>{0, 0, 0, 0}});
+  object.mesh->draw_parts([&](size_t part) { return cluster_in_rect(object.cluster_bounds[part], item.poses, lens, cull_rect); });
+}
+
+}  // namespace
+
 void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, const Lighting& lighting,
-                          std::span<const ObjectAtInstant> objects) {
+                          std::span<const ObjectAtInstant> objects, const PixelRect& cull_rect) {
   const ShadowMethod method = lighting.shadow ? lighting.shadow->method : ShadowMethod::Off;
   const GlProgram& program = shading(method);
   set_depth_state();
@@ -275,6 +325,8 @@ void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, c
   if (location("u_sky_occluder_count") >= 0) glUniform1i(location("u_sky_occluder_count"), sky_occluders);
   if (sky_occluders > 0 && location("u_sky_occluders") >= 0)
     glUniform4fv(location("u_sky_occluders"), sky_occluders, lighting.sky_occluders[0].data());
+  if (location("u_catcher_patch") >= 0) glUniform4fv(location("u_catcher_patch"), 1, lighting.catcher_patch.data());
+  const GLint ground_catcher = location("u_ground_catcher");
   const GLint world_from_object_rotation = program.uniform("u_world_from_object_rotation");
   const GLint world_from_object_translation = program.uniform("u_world_from_object_translation");
   const GLint object_scale = program.uniform("u_object_scale");
@@ -289,7 +341,7 @@ void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, c
       glUseProgram(occluder_.id());
       set_row_poses(occluder_, "pose", item.poses, item.object->scale);
       glDepthMask(item.object->writes_depth ? GL_TRUE : GL_FALSE);
-      item.object->mesh->draw([](const MeshPart&) {});
+      draw_mesh(item, lens, cull_rect, [](const MeshPart&) {});
       glUseProgram(program.id());
       continue;
     }
@@ -299,6 +351,7 @@ void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, c
     set_vec3(world_from_object_translation, item.object->T_world_object.translation());
     glUniform1f(object_scale, static_cast<float>(item.object->scale));
     glUniform1i(shadow_catcher, item.object->shadow_catcher ? 1 : 0);
+    if (ground_catcher >= 0) glUniform1i(ground_catcher, item.object->shadow_catcher && !item.object->proxy ? 1 : 0);
     glDepthMask(item.object->writes_depth ? GL_TRUE : GL_FALSE);
     glUniform1f(specular, item.object->shadow_catcher || item.object->proxy ? 0.0f : static_cast<float>(item.object->specular));
     if (item.object->specular > 0 && !item.poses.T_cam_object.empty()) {
@@ -313,7 +366,7 @@ void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, c
       const std::array<float, 27> light = object_frame_light(lighting.radiance_sh, item.object->T_world_object.rotation());
       glUniform3fv(prt_light, 9, light.data());
     }
-    item.object->mesh->draw([&](const MeshPart& part) {
+    draw_mesh(item, lens, cull_rect, [&](const MeshPart& part) {
       const std::array<float, 4>& color = item.object->base_color ? *item.object->base_color : part.base_color;
       glUniform4f(base_color, color[0], color[1], color[2], color[3]);
     });

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "render/gl/gl_program.h"
+#include "render/pixel_rect.h"
 #include "render/lens/lens_projection.h"
 #include "render/uploaded_objects.h"
 #include "render/row_poses.h"
@@ -39,6 +40,9 @@ struct Lighting {
   // projected area (x, y, z world, radius), at most kMaxSkyOccluders (the rest are left out).
   static constexpr size_t kMaxSkyOccluders = 16;
   std::vector<std::array<float, 4>> sky_occluders;
+  // The ground catcher's square (world x, y min and max), towards whose edge the sky occlusion
+  // fades to 0 so that no seam shows where the catcher ends.
+  std::array<float, 4> catcher_patch{};
 };
 
 struct ObjectAtInstant {
@@ -66,8 +70,9 @@ class ObjectRenderer {
   // frame by that ratio. Any other proxy draws (0, 0, 0, 0): only its depth, so the camera shows.
   // A proxy that hides nothing (UploadedObject::writes_depth false) leaves the depth alone; the
   // caller draws those first.
+  // cull_rect: the canvas pixels being drawn; a large proxy's clusters outside it are skipped.
   void draw(const LensUniforms& lens, const RowProjection& rows, const Lighting& lighting,
-            std::span<const ObjectAtInstant> objects);
+            std::span<const ObjectAtInstant> objects, const PixelRect& cull_rect);
   // rg = end minus start image position (pixels of the lens image), b = depth at mid-exposure (m),
   // a = 1, with depth test at the mid-exposure position; for a float colour target.
   void draw_velocity(const LensUniforms& lens, const RowProjection& rows,

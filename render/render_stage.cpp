@@ -445,13 +445,17 @@ const ShadowLookup* RenderStage::shadow_for(FrameContext& ctx, Lighting& lightin
                        : fit_shadow_frustum(shadow_light_direction_, virtual_casters, settings_.shadows.receiver_height_m, margin);
     if (virtual_only) patch = virtual_only->receiver;
   }
-  // And where they hide the sky from the ground: a sphere of radius r whose centre stands c above
-  // the ground hides r^2 c / d^3 of it at distance d, about 1 % at d = 4 r.
+  // The sky occlusion reaches further than the shadow: a sphere of radius r whose centre stands c
+  // above the ground hides r^2 c / d^3 of its sky at distance d (1 % at d = 4 r). Growing the patch
+  // that far would spread the footprint over most of the picture; it grows by 2 r, and the
+  // occlusion fades out towards its edge (render/object_renderer.cpp).
   for (const std::array<float, 4>& sphere : lighting.sky_occluders)
     for (size_t axis = 0; axis < 2; ++axis) {
-      patch.min[axis] = std::min(patch.min[axis], double(sphere[axis]) - 4.0 * sphere[3]);
-      patch.max[axis] = std::max(patch.max[axis], double(sphere[axis]) + 4.0 * sphere[3]);
+      patch.min[axis] = std::min(patch.min[axis], double(sphere[axis]) - 2.0 * sphere[3]);
+      patch.max[axis] = std::max(patch.max[axis], double(sphere[axis]) + 2.0 * sphere[3]);
     }
+  lighting.catcher_patch = {static_cast<float>(patch.min[0]), static_cast<float>(patch.min[1]),
+                            static_cast<float>(patch.max[0]), static_cast<float>(patch.max[1])};
   const UploadedObject& catcher = receiver_->over(patch);
   // Variance maps also hold the ground, so that filtering across an object's edge blends its depth
   // with the ground's rather than with empty space.

@@ -14,6 +14,7 @@
 #include "core/scene/builtin_meshes.h"
 #include "core/scene/gltf_loader.h"
 #include "render/prt/prt_cache.h"
+#include "render/proxy_clusters.h"
 
 namespace arpipe {
 namespace {
@@ -165,7 +166,9 @@ std::vector<UploadedObject> upload_proxies(const Config& config, const LoadedMes
     UploadedObject object;
     object.mesh_source = proxy.mesh;
     object.name = proxy.name.empty() ? fmt::format("proxy {}", i) : proxy.name;
-    object.mesh = std::make_shared<const GpuMesh>(*loaded.proxies[i].mesh);
+    ClusteredMesh clustered = cluster_for_culling(*loaded.proxies[i].mesh);
+    object.mesh = std::make_shared<const GpuMesh>(clustered.mesh);
+    for (const Bounds& b : clustered.bounds) object.cluster_bounds.push_back(scaled(b, proxy.scale));
     object.scale = proxy.scale;
     object.bounds = scaled(loaded.proxies[i].mesh->bounds(), proxy.scale);
     object.T_world_object = proxy_placement(proxy);

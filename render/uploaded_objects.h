@@ -40,6 +40,9 @@ struct UploadedObject {
   // The radius of a sphere with the object's mean projected area (a convex body's is a quarter of
   // its surface), scaled: how much sky it hides from the ground beside it (object_renderer.h).
   double sky_radius_m = 0;
+  // A large proxy's culling clusters (render/proxy_clusters.h): per part of its mesh, the part's
+  // bounds in the object frame, scaled. Empty: drawn whole.
+  std::vector<Bounds> cluster_bounds;
 };
 
 

@@ -386,8 +386,10 @@ struct ShadowConfig {
   // estimates bring their own (0.53 degrees for the sun).
   double light_angular_diameter_deg = 2.0;
   // The virtual objects also hide part of the ambient light from the real surfaces beside them
-  // (each as a sphere of its mean projected area); the catcher darkens those surfaces too.
-  bool sky_occlusion = true;
+  // (each as a sphere of its mean projected area); the catcher darkens those surfaces too. Off
+  // by default: closer to the truth outdoors (bench shadows), but the ground catcher grows by
+  // two of the spheres' radii, and the footprint with it.
+  bool sky_occlusion = false;
 
   bool operator==(const ShadowConfig&) const = default;
 };
@@ -406,7 +408,7 @@ void visit(V& v, ShadowConfig& s) {
   v.key("receiver_height_m", s.receiver_height_m, "world z of the real ground");
   v.key("light_angular_diameter_deg", s.light_angular_diameter_deg, NumberRange::closed_open(0, 90).in("degrees"),
         "size of the fixed light (pcss); estimates bring their own");
-  v.key("sky_occlusion", s.sky_occlusion, "the objects also hide ambient light from the real surfaces beside them");
+  v.key("sky_occlusion", s.sky_occlusion, "the objects also hide ambient light from the real surfaces beside them (costs footprint)");
 }
 
 // The precomputed radiance transfer bake (render/prt): run once per mesh and kept in a cache

@@ -62,4 +62,15 @@ void GpuMesh::draw(const std::function<void(const MeshPart&)>& before_part) cons
   glBindVertexArray(0);
 }
 
+void GpuMesh::draw_parts(const std::function<bool(size_t part)>& include) const {
+  glBindVertexArray(vertex_array_.get());
+  for (size_t i = 0; i < parts_.size(); ++i) {
+    if (!include(i)) continue;
+    const MeshPart& part = parts_[i];
+    glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(part.index_count), GL_UNSIGNED_INT,
+                   reinterpret_cast<const void*>(uintptr_t{part.first_index} * sizeof(uint32_t)));
+  }
+  glBindVertexArray(0);
+}
+
 }  // namespace arpipe

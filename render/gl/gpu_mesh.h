@@ -24,6 +24,9 @@ class GpuMesh {
   bool has_transfer() const { return has_transfer_; }
   // Draws each part after calling before_part(part), which sets the part's uniforms.
   void draw(const std::function<void(const MeshPart&)>& before_part) const;
+  // Only the parts whose index `include` says yes to (culling), with nothing set between them.
+  void draw_parts(const std::function<bool(size_t part)>& include) const;
+  size_t part_count() const { return parts_.size(); }
 
  private:
   GlVertexArray vertex_array_;
