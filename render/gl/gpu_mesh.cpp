@@ -63,12 +63,19 @@ void GpuMesh::draw(const std::function<void(const MeshPart&)>& before_part) cons
 }
 
 void GpuMesh::draw_parts(const std::function<bool(size_t part)>& include) const {
+  // Consecutive parts go in one call (culling clusters come in runs along their Morton curve).
   glBindVertexArray(vertex_array_.get());
-  for (size_t i = 0; i < parts_.size(); ++i) {
-    if (!include(i)) continue;
-    const MeshPart& part = parts_[i];
-    glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(part.index_count), GL_UNSIGNED_INT,
-                   reinterpret_cast<const void*>(uintptr_t{part.first_index} * sizeof(uint32_t)));
+  size_t i = 0;
+  while (i < parts_.size()) {
+    if (!include(i)) {
+      ++i;
+      continue;
+    }
+    const uint32_t first = parts_[i].first_index;
+    uint32_t end = first + parts_[i].index_count;
+    for (++i; i < parts_.size() && parts_[i].first_index == end && include(i); ++i) end += parts_[i].index_count;
+    glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(end - first), GL_UNSIGNED_INT,
+                   reinterpret_cast<const void*>(uintptr_t{first} * sizeof(uint32_t)));
   }
   glBindVertexArray(0);
 }
