@@ -54,7 +54,7 @@ int run_simulate(SimulateOptions& command) {
   log::info("wrote {} frames to {} in {:.1f} s ({:.1f} s setup, {:.2f} s per frame{})", summary.frames,
             options.out_dir.string(), summary.seconds, summary.setup_seconds,
             (summary.seconds - summary.setup_seconds) / summary.frames,
-            summary.wrote_composite ? ", with the ground-truth composite" : "");
+            summary.wrote_composite ? ", with the ground-truth composite and coverage" : "");
   return 0;
 }
 
@@ -63,7 +63,9 @@ int run_simulate(SimulateOptions& command) {
 void add_simulate_command(CLI::App& arpipe) {
   CLI::App* command = arpipe.add_subcommand(
       "simulate", "render a simulator scene (configs/sim/, docs/SIMULATOR.md) into a recording with exact ground truth");
-  command->footer("DIR must not hold a recording; DIR/ground_truth_composite is written when the scene has virtual objects.");
+  command->footer(
+      "DIR must not hold a recording; DIR/ground_truth_composite and DIR/ground_truth_coverage (the virtual objects'\n"
+      "visible coverage per pixel) are written when the scene has virtual objects.");
   auto options = std::make_shared<SimulateOptions>();
   command->add_option("--scene", options->scene_path, "the simulator scene")->type_name("FILE")->required();
   command->add_option("--out", options->simulate.out_dir, "where the recording goes")->type_name("DIR")->required();
