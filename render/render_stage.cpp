@@ -220,6 +220,18 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
     motion.max_image_motion_px = 0;
   }
   if (physics_ && move_objects(motion)) reuse_.forget();
+  if (physics_) {
+    PhysicsReport report;
+    report.restarts = physics_->restarts();
+    if (const RigidWorldStats* stats = physics_->stats()) {
+      report.substeps = stats->substeps;
+      report.capped_advances = stats->capped_advances;
+      report.removed_below_floor = stats->removed_below_floor;
+      report.removed_beyond_radius = stats->removed_beyond_radius;
+      report.removed_non_finite = stats->removed_non_finite;
+    }
+    ctx.physics = report;
+  }
   if (occlusion_meter_) {
     const auto measure_start = std::chrono::steady_clock::now();
     ctx.objects = occlusion_meter_->measure(camera, ctx.pose.T_cam_world, objects_, proxies_);

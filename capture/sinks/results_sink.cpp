@@ -104,6 +104,15 @@ nlohmann::json ResultsSink::to_json(const FrameContext& ctx) {
     }
     j["objects"] = std::move(objects);
   }
+  if (ctx.physics) {
+    const PhysicsReport& p = *ctx.physics;
+    j["physics"] = {{"substeps", p.substeps},
+                    {"restarts", p.restarts},
+                    {"capped_advances", p.capped_advances},
+                    {"removed", {{"below_floor", p.removed_below_floor},
+                                 {"beyond_radius", p.removed_beyond_radius},
+                                 {"non_finite", p.removed_non_finite}}}};
+  }
   json timings = json::object();
   json skips = json::object();
   for (const auto& t : ctx.timings) {

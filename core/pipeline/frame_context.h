@@ -90,6 +90,7 @@ struct FrameContext {
   // Per virtual object, where it is and how much the proxies hid (the render stage; empty unless
   // the config has proxies or physics).
   std::vector<ObjectReport> objects;
+  std::optional<PhysicsReport> physics;  // with a physics world (render.objects[].physics)
   std::vector<StageTiming> timings;
   uint64_t input_index = 0;                     // position in the stream as the pipeline saw it
   uint64_t dropped_before = 0;                  // frames lost just before this one (sequence gap or queue drop)

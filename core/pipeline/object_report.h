@@ -3,6 +3,9 @@
 // phantom proxies hid, and which.
 #pragma once
 
+#include <cstddef>
+#include <cstdint>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -20,6 +23,17 @@ struct ObjectReport {
   // all and per proxy (by name, the nearest one in front). Measured when in view; 0 otherwise.
   double hidden = 0;
   std::vector<std::pair<std::string, double>> hidden_by;
+};
+
+// The rigid-body world's counters (render/scene_physics.h), since the daemon started, for the
+// frames of a config with physics: what was simulated and what left the world.
+struct PhysicsReport {
+  int64_t substeps = 0;
+  int64_t restarts = 0;          // a replay that started over built the world again
+  int64_t capped_advances = 0;   // frames after a gap longer than render.physics.max_advance_ms
+  size_t removed_below_floor = 0;
+  size_t removed_beyond_radius = 0;
+  size_t removed_non_finite = 0;
 };
 
 }  // namespace arpipe
