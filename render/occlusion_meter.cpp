@@ -5,26 +5,28 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <optional>
+#include <utility>
 
 namespace arpipe {
 namespace {
 
-// The ray origin + t dir (world) in an object's mesh frame, scale included: the same t.
-struct LocalRay {
-  Vec3 origin;
-  Vec3 dir;
-};
-LocalRay to_local(const SE3& T_world_object, double scale, const Vec3& origin, const Vec3& dir) {
-  const SE3 T_object_world = T_world_object.inverse();
-  return {(1 / scale) * (T_object_world * origin), (1 / scale) * T_object_world.rotate(dir)};
-}
+// A mesh's ray scene with its placement for this frame: rays go into its frame (scale included,
+// so that t stays the same) with the inverse computed once per frame, not once per ray.
+struct PlacedScene {
+  const PrtRayScene* scene = nullptr;
+  SE3 T_object_world;
+  double inverse_scale = 1;
 
-std::optional<float> hit_distance(const PrtRayScene& scene, const UploadedObject& object, const Vec3& origin, const Vec3& dir) {
-  const LocalRay ray = to_local(object.T_world_object, object.scale, origin, dir);
-  const PrtRayHit hit = scene.closest_hit(ray.origin, ray.dir);
-  if (!hit.hit) return std::nullopt;
-  return hit.t;
-}
+  PlacedScene(const PrtRayScene* s, const UploadedObject& object)
+      : scene(s), T_object_world(object.T_world_object.inverse()), inverse_scale(1 / object.scale) {}
+  std::optional<float> hit_distance(const Vec3& origin, const Vec3& dir) const {
+    const PrtRayHit hit =
+        scene->closest_hit(inverse_scale * (T_object_world * origin), inverse_scale * T_object_world.rotate(dir));
+    if (!hit.hit) return std::nullopt;
+    return hit.t;
+  }
+};
 
 }  // namespace
 
@@ -50,6 +52,10 @@ std::vector<ObjectReport> OcclusionMeter::measure(const CameraModel& camera, con
   const SE3 T_world_cam = T_cam_world.inverse();
   const Vec3 eye = T_world_cam.translation();
   const double fx = camera.fx(), fy = camera.fy(), cx = camera.cx(), cy = camera.cy();
+  std::vector<std::optional<PlacedScene>> occluders;
+  for (size_t p = 0; p < proxies.size() && p < proxy_scenes_.size(); ++p)
+    occluders.push_back(proxy_scenes_[p] ? std::optional<PlacedScene>(std::in_place, proxy_scenes_[p].get(), proxies[p])
+                                         : std::nullopt);
   for (size_t i = 0; i < objects.size() && i < object_scenes_.size(); ++i) {
     const UploadedObject& object = objects[i];
     ObjectReport report;
@@ -73,20 +79,21 @@ std::vector<ObjectReport> OcclusionMeter::measure(const CameraModel& camera, con
     u1 = std::min(u1, camera.width() - 0.5), v1 = std::min(v1, camera.height() - 0.5);
     report.in_view = object.present && !behind && u1 > u0 && v1 > v0;
     if (report.in_view) {
+      const PlacedScene placed(object_scenes_[i].get(), object);
       int met = 0;
       std::vector<int> hidden_by(proxies.size(), 0);
       for (int gy = 0; gy < kGrid; ++gy)
         for (int gx = 0; gx < kGrid; ++gx) {
           const double u = u0 + (gx + 0.5) * (u1 - u0) / kGrid, v = v0 + (gy + 0.5) * (v1 - v0) / kGrid;
           const Vec3 dir = T_world_cam.rotate(Vec3{(u - cx) / fx, (v - cy) / fy, 1.0});
-          const std::optional<float> t_object = hit_distance(*object_scenes_[i], object, eye, dir);
+          const std::optional<float> t_object = placed.hit_distance(eye, dir);
           if (!t_object) continue;
           ++met;
           float nearest = *t_object;
           std::optional<size_t> by;
-          for (size_t p = 0; p < proxies.size() && p < proxy_scenes_.size(); ++p) {
-            if (!proxy_scenes_[p]) continue;
-            const std::optional<float> t_proxy = hit_distance(*proxy_scenes_[p], proxies[p], eye, dir);
+          for (size_t p = 0; p < occluders.size(); ++p) {
+            if (!occluders[p]) continue;
+            const std::optional<float> t_proxy = occluders[p]->hit_distance(eye, dir);
             if (t_proxy && *t_proxy < nearest) nearest = *t_proxy, by = p;
           }
           if (by) ++hidden_by[*by];
