@@ -65,7 +65,6 @@ uniform bool u_shadow_catcher;
 out vec4 out_color;              // linear, premultiplied alpha
 {shadow_lookup}
 {real_shadow_lookup}
-uniform bool u_real_shadow;    // a map of the real casters alone is bound
 // The virtual objects as spheres of their mean projected area (xyz: centre, world; w: radius).
 uniform int u_sky_occluder_count;
 uniform vec4 u_sky_occluders[{max_sky_occluders}];
@@ -104,7 +103,9 @@ void main() {{
   vec3 towards_light = u_light_position.w > 0.5 ? normalize(u_light_position.xyz - v_world) : u_light_direction;
   float lambert = max(dot(normal, towards_light), 0.0);
   float visibility = shadow_visibility(v_world);  // uniform control flow: it takes derivatives
-  float real_visibility = u_real_shadow ? real_shadow_visibility(v_world) : 1.0;  // a uniform's branch
+  // The real casters' own map: compiled in only when proxies cast (else a constant 1), since a
+  // uniform's branch would still cost the lookup on a software rasteriser.
+  float real_visibility = real_shadow_visibility(v_world);
   if (u_shadow_catcher) {{
     // Differential rendering: the real surface's light with the virtual shadow over its light
     // without it, where the real casters already shade it as they do in the picture. One ratio
@@ -232,18 +233,20 @@ ObjectRenderer::ObjectRenderer()
   prepare(ShadowMethod::Off);
 }
 
-void ObjectRenderer::prepare(ShadowMethod method) { shading(method); }
+void ObjectRenderer::prepare(ShadowMethod method) { shading(method, false); }
 
-const GlProgram& ObjectRenderer::shading(ShadowMethod method) {
-  auto found = shading_.find(method);
+const GlProgram& ObjectRenderer::shading(ShadowMethod method, bool real_shadow) {
+  const std::pair<ShadowMethod, bool> key{method, real_shadow};
+  auto found = shading_.find(key);
   if (found == shading_.end()) {
-    const std::string fragment = fmt::format(fmt::runtime(kShadingFragmentShaderTemplate),
-                                             fmt::arg("shadow_lookup", shadow_lookup_glsl(method)),
-                                             fmt::arg("real_shadow_lookup", shadow_lookup_glsl(method, "real_")),
-                                             fmt::arg("max_sky_occluders", Lighting::kMaxSkyOccluders));
+    const std::string fragment =
+        fmt::format(fmt::runtime(kShadingFragmentShaderTemplate), fmt::arg("shadow_lookup", shadow_lookup_glsl(method)),
+                    fmt::arg("real_shadow_lookup", shadow_lookup_glsl(real_shadow ? method : ShadowMethod::Off, "real_")),
+                    fmt::arg("max_sky_occluders", Lighting::kMaxSkyOccluders));
     found = shading_
-                .emplace(method, GlProgram(fmt::format("object shading ({} shadows)", shadow_method_name(method)),
-                                           vertex_source({"pose"}, kShadingVertexShader), fragment))
+                .emplace(key, GlProgram(fmt::format("object shading ({} shadows{})", shadow_method_name(method),
+                                                    real_shadow ? ", real casters" : ""),
+                                        vertex_source({"pose"}, kShadingVertexShader), fragment))
                 .first;
   }
   return found->second;
@@ -291,7 +294,8 @@ void draw_mesh(const ObjectAtInstant& item, const LensUniforms& lens, const Pixe
 void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, const Lighting& lighting,
                           std::span<const ObjectAtInstant> objects, const PixelRect& cull_rect) {
   const ShadowMethod method = lighting.shadow ? lighting.shadow->method : ShadowMethod::Off;
-  const GlProgram& program = shading(method);
+  const bool real = lighting.shadow && lighting.real_shadow;
+  const GlProgram& program = shading(method, real);
   set_depth_state();
   const bool any_occluder = std::any_of(objects.begin(), objects.end(), [](const ObjectAtInstant& item) {
     return item.object->proxy && !item.object->shadow_catcher;
@@ -318,8 +322,6 @@ void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, c
   if (lighting.shadow) set_shadow_lookup_uniforms(program, *lighting.shadow, 1);
   // Without shadows the catcher never runs and the compiler drops these: set only those it kept.
   const auto location = [&](const char* name) { return glGetUniformLocation(program.id(), name); };
-  const bool real = lighting.shadow && lighting.real_shadow;
-  if (location("u_real_shadow") >= 0) glUniform1i(location("u_real_shadow"), real ? 1 : 0);
   if (real) set_shadow_lookup_uniforms(program, *lighting.real_shadow, 2, "real_");
   const int sky_occluders = static_cast<int>(std::min(lighting.sky_occluders.size(), Lighting::kMaxSkyOccluders));
   if (location("u_sky_occluder_count") >= 0) glUniform1i(location("u_sky_occluder_count"), sky_occluders);

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <map>
+#include <utility>
 #include <span>
 #include <vector>
 
@@ -79,8 +80,9 @@ class ObjectRenderer {
                      std::span<const ObjectOverExposure> objects) const;
 
  private:
-  const GlProgram& shading(ShadowMethod method);
-  std::map<ShadowMethod, GlProgram> shading_;  // one per shadow lookup
+  // real_shadow: with the real casters' map (proxies that cast), else its lookup is a constant 1.
+  const GlProgram& shading(ShadowMethod method, bool real_shadow);
+  std::map<std::pair<ShadowMethod, bool>, GlProgram> shading_;  // one per shadow lookup
   GlProgram velocity_;
   GlProgram occluder_;  // proxies that hide but catch no shadow: depth only
 };
