@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,7 @@ struct ProxyVariant {
   std::string label;
   std::vector<SceneProxy> proxies;
   size_t triangles = 0;
+  std::optional<double> lod_px;  // render.occluder_lod_px for this row; none: the config's
 };
 
 void write_glb(const Mesh& mesh, const fs::path& path) {
@@ -44,13 +46,13 @@ void write_glb(const Mesh& mesh, const fs::path& path) {
 // faces split into n x n squares, the cylinder with many segments: about 10k triangles each.
 std::vector<ProxyVariant> variants(const Config& config, const fs::path& work) {
   std::vector<ProxyVariant> out;
-  out.push_back({"no proxies (the cube drawn whole)", {}, 0});
-  ProxyVariant builtin{"builtin proxies (a box, a 48-gon cylinder)", config.render.proxies, 0};
+  out.push_back({"no proxies (the cube drawn whole)", {}, 0, {}});
+  ProxyVariant builtin{"builtin proxies (a box, a 48-gon cylinder)", config.render.proxies, 0, {}};
   for (const SceneProxy& p : config.render.proxies)  // as render/uploaded_objects.cpp makes them
     builtin.triangles += make_builtin_mesh(p.mesh, p.size_m, config.render.lens == LensMode::Vertex ? 8 : 1)->triangle_count();
   out.push_back(builtin);
-  ProxyVariant fine{"10k-triangle glTF proxies", config.render.proxies, 0};
-  ProxyVariant simplified{"the same simplified 10:1 (meshoptimizer)", config.render.proxies, 0};
+  ProxyVariant fine{"10k-triangle glTF proxies", config.render.proxies, 0, {}};
+  ProxyVariant simplified{"the same simplified 10:1 (meshoptimizer)", config.render.proxies, 0, {}};
   for (size_t i = 0; i < fine.proxies.size(); ++i) {
     SceneProxy& p = fine.proxies[i];
     Mesh mesh = p.mesh == "builtin:box" ? make_box_mesh(p.size_m, 29)            // 6 x 29^2 x 2 = 10092
@@ -68,6 +70,10 @@ std::vector<ProxyVariant> variants(const Config& config, const fs::path& work) {
     simplified.proxies[i].mesh = reduced.string();
   }
   out.push_back(fine);
+  ProxyVariant fine_full = fine;
+  fine_full.label = "10k-triangle glTF proxies, no occluder levels (render.occluder_lod_px = 0)";
+  fine_full.lod_px = 0;
+  out.push_back(fine_full);
   out.push_back(simplified);
   return out;
 }
@@ -81,18 +87,32 @@ int run_proxies_benchmark(const fs::path& capture, const fs::path& config_path, 
     const std::vector<ProxyVariant> rows = variants(base, work);
     std::printf("%s with %s: every frame drawn %d times, ground-truth camera motion\n\n", capture.string().c_str(),
                 config_path.string().c_str(), repeats);
-    std::printf("| proxies | triangles | render ms, no shadows | render ms, shadows | of which the hidden-share report | "
-                "edge error, still frames (mean / worst) | edge error, blurred frames (mean / worst) |\n");
-    std::printf("|---|---|---|---|---|---|---|\n");
+    std::printf("| proxies | triangles | render ms, no shadows | render ms, shadows | render ms, occluders only | "
+                "the occluders' share | of which the hidden-share report | edge error, still frames (mean / worst) | "
+                "edge error, blurred frames (mean / worst) |\n");
+    std::printf("|---|---|---|---|---|---|---|---|---|\n");
+    double no_proxies_ms = 0;
     for (const ProxyVariant& row : rows) {
       Config config = base;
       config.render.proxies = row.proxies;
+      if (row.lod_px) config.render.occluder_lod_px = *row.lod_px;
       const bench::ProxyCaptureRun lit = bench::run_proxy_capture(capture, config, repeats);
+      // The occluder pass alone: the same proxies with the one role, the config's shadows on.
+      Config occluding = config;
+      for (SceneProxy& proxy : occluding.render.proxies) {
+        proxy.roles.occlude = true;
+        proxy.roles.receive_shadows = proxy.roles.cast_shadows = false;
+      }
+      const bench::ProxyCaptureRun hiding = row.proxies.empty() ? lit : bench::run_proxy_capture(capture, occluding, repeats);
+      if (row.proxies.empty()) no_proxies_ms = lit.render_ms;
       config.render.shadows.method = ShadowMethod::Off;
       const bench::ProxyCaptureRun plain = bench::run_proxy_capture(capture, config, repeats);
-      std::printf("| %s | %zu | %.2f | %.2f | %.2f | %.3f / %.3f px | %.3f / %.3f px |\n", row.label.c_str(), row.triangles,
-                  plain.render_ms, lit.render_ms, lit.occlusion_ms, plain.mean_still_px, plain.worst_still_px,
-                  plain.mean_blurred_px, plain.worst_blurred_px);
+      const std::string share =
+          row.proxies.empty() ? std::string("-")
+                              : fmt::format("{:.0f} %", 100.0 * (hiding.render_ms - no_proxies_ms) / hiding.render_ms);
+      std::printf("| %s | %zu | %.2f | %.2f | %.2f | %s | %.2f | %.3f / %.3f px | %.3f / %.3f px |\n", row.label.c_str(),
+                  row.triangles, plain.render_ms, lit.render_ms, hiding.render_ms, share.c_str(), lit.occlusion_ms,
+                  plain.mean_still_px, plain.worst_still_px, plain.mean_blurred_px, plain.worst_blurred_px);
       std::fflush(stdout);
     }
     fs::remove_all(work);

@@ -289,16 +289,34 @@ void draw_mesh(const ObjectAtInstant& item, const LensUniforms& lens, const Pixe
   object.mesh->draw_parts([&](size_t part) { return cluster_in_rect(object.cluster_bounds[part], item.poses, lens, cull_rect); });
 }
 
+// The coarsest occluder level of the item's proxy that strays at most tolerance_px at the nearest
+// corner of its box over the item's row poses; null: the full mesh (no level fits, the box reaches
+// the near plane, or the lens is applied per vertex, which long edges would not follow).
+const GpuMesh* occluder_level_for(const ObjectAtInstant& item, const LensUniforms& lens, double tolerance_px) {
+  const UploadedObject& object = *item.object;
+  if (object.occluder_levels.empty() || lens.distorted || !(tolerance_px > 0)) return nullptr;
+  double nearest = INFINITY;
+  for (const SE3& T_cam_object : item.poses.T_cam_object)
+    for (const Vec3& corner : box_corners(object.bounds)) nearest = std::min(nearest, (T_cam_object * corner)[2]);
+  if (!(nearest > kNearPlaneM)) return nullptr;
+  const int chosen = coarsest_occluder_level(object.occluder_level_errors_m,
+                                             std::max(lens.focal_center[0], lens.focal_center[1]), nearest, tolerance_px);
+  return chosen < 0 ? nullptr : object.occluder_levels[size_t(chosen)].get();
+}
+
 }  // namespace
 
 void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, const Lighting& lighting,
-                          std::span<const ObjectAtInstant> objects, const PixelRect& cull_rect) {
+                          std::span<const ObjectAtInstant> objects, const PixelRect& cull_rect, double occluder_lod_px) {
   const ShadowMethod method = lighting.shadow ? lighting.shadow->method : ShadowMethod::Off;
   const bool real = lighting.shadow && lighting.real_shadow;
   const GlProgram& program = shading(method, real);
   set_depth_state();
-  const bool any_occluder = std::any_of(objects.begin(), objects.end(), [](const ObjectAtInstant& item) {
-    return item.object->proxy && !item.object->shadow_catcher;
+  // A proxy shades only to catch a shadow; without one this frame it hides (depth only) or is
+  // not drawn at all.
+  const auto shades = [&](const UploadedObject& object) { return !object.proxy || (object.shadow_catcher && lighting.shadow); };
+  const bool any_occluder = std::any_of(objects.begin(), objects.end(), [&](const ObjectAtInstant& item) {
+    return !shades(*item.object) && item.object->writes_depth;
   });
   if (any_occluder) {
     set_lens_uniforms(occluder_, lens);
@@ -339,11 +357,13 @@ void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, c
   const GLint camera_world = program.uniform("u_camera_world");
   const GLint prt_light = program.uniform("u_prt_light");
   for (const ObjectAtInstant& item : objects) {
-    if (item.object->proxy && !item.object->shadow_catcher) {
+    if (!shades(*item.object)) {
+      if (!item.object->writes_depth) continue;
       glUseProgram(occluder_.id());
       set_row_poses(occluder_, "pose", item.poses, item.object->scale);
-      glDepthMask(item.object->writes_depth ? GL_TRUE : GL_FALSE);
-      draw_mesh(item, lens, cull_rect, [](const MeshPart&) {});
+      glDepthMask(GL_TRUE);
+      if (const GpuMesh* level = occluder_level_for(item, lens, occluder_lod_px)) level->draw([](const MeshPart&) {});
+      else draw_mesh(item, lens, cull_rect, [](const MeshPart&) {});
       glUseProgram(program.id());
       continue;
     }

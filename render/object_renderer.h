@@ -72,8 +72,10 @@ class ObjectRenderer {
   // A proxy that hides nothing (UploadedObject::writes_depth false) leaves the depth alone; the
   // caller draws those first.
   // cull_rect: the canvas pixels being drawn; a large proxy's clusters outside it are skipped.
+  // occluder_lod_px: a proxy drawn depth-only uses its coarsest occluder level that strays at most
+  // this far at its nearest point (UploadedObject::occluder_levels); 0: its full mesh.
   void draw(const LensUniforms& lens, const RowProjection& rows, const Lighting& lighting,
-            std::span<const ObjectAtInstant> objects, const PixelRect& cull_rect);
+            std::span<const ObjectAtInstant> objects, const PixelRect& cull_rect, double occluder_lod_px = 0);
   // rg = end minus start image position (pixels of the lens image), b = depth at mid-exposure (m),
   // a = 1, with depth test at the mid-exposure position; for a float colour target.
   void draw_velocity(const LensUniforms& lens, const RowProjection& rows,

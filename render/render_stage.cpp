@@ -93,6 +93,7 @@ void RenderStage::configure_loaded(const Config& config, const std::shared_ptr<c
   settings.max_predicted_uncertainty_deg = config.render.max_predicted_uncertainty_deg;
   settings.reuse_layer = config.render.reuse_layer;
   settings.full_canvas = config.render.full_canvas;
+  settings.occluder_lod_px = config.render.occluder_lod_px;
   settings.default_exposure_ns = config.motion.default_exposure_ns;
   settings.blur = config.render.blur;
   settings.shadows = config.render.shadows;
@@ -330,6 +331,7 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
   request.image_motion_px = motion.valid() ? std::max(motion.max_image_motion_px, moving_objects_motion_px(motion, image_camera)) : 0;
   request.msaa_samples = settings_.msaa_samples;
   request.rolling_shutter = settings_.rolling_shutter;
+  request.occluder_lod_px = settings_.occluder_lod_px;
 
   LayerReuse::Inputs inputs{ctx.camera_model, exposure_poses, request.objects, request.lighting, shadow_redrawn, rect};
   if (settings_.reuse_layer && reuse_.can_reuse(inputs)) {

@@ -146,6 +146,8 @@ LoadedMeshes load_object_meshes(const Config& config) {
     if (!proxy.collision_mesh.empty())
       entry.collision = load_proxy_mesh(config, fmt::format("render.proxies[{}].collision_mesh", i), proxy.collision_mesh,
                                         proxy.size_m);
+    if (proxy.roles.occlude && config.render.occluder_lod_px > 0 && config.render.lens != LensMode::Vertex)
+      entry.occluder_levels = make_occluder_levels(*entry.mesh);
     loaded.proxies.push_back(std::move(entry));
   }
   return loaded;
@@ -177,6 +179,17 @@ std::vector<UploadedObject> upload_proxies(const Config& config, const LoadedMes
     object.writes_depth = proxy.roles.occlude;
     object.casts_shadows = proxy.roles.cast_shadows;
     object.base_color = std::array<float, 4>{0, 0, 0, 0};
+    for (const OccluderLevel& level : loaded.proxies[i].occluder_levels)
+    {
+      object.occluder_levels.push_back(std::make_shared<const GpuMesh>(*level.mesh));
+      object.occluder_level_errors_m.push_back(level.error * proxy.scale);
+    }
+    if (!object.occluder_levels.empty()) {
+      std::string sizes;
+      for (const OccluderLevel& level : loaded.proxies[i].occluder_levels)
+        sizes += fmt::format(", {} ({:.2g} mm)", level.mesh->triangle_count(), 1e3 * level.error * proxy.scale);
+      log::info("proxy {}: occluder levels of {} triangles{}", object.name, loaded.proxies[i].mesh->triangle_count(), sizes);
+    }
     out.push_back(std::move(object));
   }
   return out;

@@ -13,6 +13,7 @@
 #include "core/geometry/se3.h"
 #include "render/gl/gpu_mesh.h"
 #include "core/scene/mesh.h"
+#include "core/scene/occluder_levels.h"
 
 namespace arpipe {
 
@@ -43,6 +44,10 @@ struct UploadedObject {
   // A large proxy's culling clusters (render/proxy_clusters.h): per part of its mesh, the part's
   // bounds in the object frame, scaled. Empty: drawn whole.
   std::vector<Bounds> cluster_bounds;
+  // A proxy's coarser meshes for drawing it depth-only (core/scene/occluder_levels.h), finest
+  // first, each with its error scaled (m); empty: always the full mesh.
+  std::vector<std::shared_ptr<const GpuMesh>> occluder_levels;
+  std::vector<double> occluder_level_errors_m;
 };
 
 
@@ -62,6 +67,7 @@ struct LoadedMeshes {
   struct Proxy {
     std::shared_ptr<const Mesh> mesh;
     std::shared_ptr<const Mesh> collision;
+    std::vector<OccluderLevel> occluder_levels;  // made only for proxies that occlude
   };
   std::vector<Proxy> proxies;
 };

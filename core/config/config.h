@@ -460,6 +460,10 @@ struct RenderConfig {
   // Every pass over the whole image instead of the objects' footprint: the same picture at the
   // whole frame's cost, for checking the footprint (tests/render/footprint_test.cpp).
   bool full_canvas = false;
+  // Proxies that only hide are drawn from the coarsest level of their mesh whose surface strays at
+  // most this many canvas pixels from the full mesh's at the proxy's nearest point
+  // (core/scene/occluder_levels.h); 0: always the full mesh.
+  double occluder_lod_px = 0.1;
   BlurConfig blur;
   ShadowConfig shadows;
   PrtConfig prt;
@@ -493,6 +497,8 @@ void visit(V& v, RenderConfig& s) {
         "a predicted pose less certain than this is not drawn");
   v.key("reuse_layer", s.reuse_layer, "hand the last virtual layer on while pose, light and objects are unchanged");
   v.key("full_canvas", s.full_canvas, "every pass over the whole image, not the objects' footprint (for checking it)");
+  v.key("occluder_lod_px", s.occluder_lod_px, NumberRange::closed(0, 10).in("pixels"),
+        "proxies that only hide are drawn from a coarser mesh that strays at most this far; 0: the full mesh");
   v.section("blur", s.blur, "motion blur of the virtual layer over each exposure");
   v.section("shadows", s.shadows, "shadows of the virtual objects, on themselves and on the real ground");
   v.section("prt", s.prt, "precomputed radiance transfer, baked once per mesh (arpipe bake)");

@@ -143,26 +143,61 @@ std::string_view simplify_method_name(SimplifyMethod method) {
   return "?";
 }
 
-MeshSimplifyResult simplify_mesh(const Mesh& mesh, const MeshSimplifySettings& settings) {
-  const auto start = std::chrono::steady_clock::now();
-  check_simplify_settings(settings);
+namespace {
+
+// The weld and meshopt's scale: what both kinds of simplification start from.
+struct SimplifyStart {
+  WeldedMesh welded;
   MeshSimplifyResult result;
+};
+
+SimplifyStart start_simplify(const Mesh& mesh, double weld_tolerance) {
+  SimplifyStart start;
+  MeshSimplifyResult& result = start.result;
   result.input_triangles = mesh.triangle_count();
   result.input_vertices = mesh.vertex_count();
   const Bounds box = mesh.bounds();
   const double size = std::max({box.max[0] - box.min[0], box.max[1] - box.min[1], box.max[2] - box.min[2]});
-  const WeldedMesh welded = weld_by_position(mesh, settings.weld_tolerance * size);  // checks the mesh
-  result.welded_vertices = welded.vertex_count();
-  result.welded_triangles = welded.triangle_count();
-  result.input_unpaired_edges = count_unpaired_edges(welded);
+  start.welded = weld_by_position(mesh, weld_tolerance * size);  // checks the mesh
+  result.welded_vertices = start.welded.vertex_count();
+  result.welded_triangles = start.welded.triangle_count();
+  result.input_unpaired_edges = count_unpaired_edges(start.welded);
+  result.scale_m =
+      meshopt_simplifyScale(start.welded.positions.data(), start.welded.vertex_count(), 3 * sizeof(float));
+  return start;
+}
+
+// The simplified triangles made a mesh again: colours carried over, normals made.
+void finish_simplify(const Mesh& mesh, const WeldedMesh& welded, const std::vector<uint32_t>& simplified,
+                     ProxyNormals normals, MeshSimplifyResult& result,
+                     std::chrono::steady_clock::time_point start) {
+  WeldedMesh simplified_welded{welded.positions, simplified, {}};
+  result.output_unpaired_edges = count_unpaired_edges(simplified_welded);
+  std::vector<SimplifyRgba> colours;
+  const std::vector<uint32_t> part_colour = colour_of_parts(mesh, colours);
+  std::vector<uint32_t> colour_of_triangle = triangle_colours(welded, part_colour, simplified);
+  std::vector<bool> used(colours.size(), false);
+  for (uint32_t t : welded.triangle_part) used[part_colour[t]] = true;
+  result.colours = static_cast<size_t>(std::count(used.begin(), used.end(), true));
+  result.mesh = build_simplified_mesh(welded, simplified, colour_of_triangle, colours, normals);
+  result.mesh.source = mesh.source;
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+MeshSimplifyResult simplify_mesh(const Mesh& mesh, const MeshSimplifySettings& settings) {
+  const auto start = std::chrono::steady_clock::now();
+  check_simplify_settings(settings);
+  SimplifyStart begun = start_simplify(mesh, settings.weld_tolerance);
+  const WeldedMesh& welded = begun.welded;
+  MeshSimplifyResult& result = begun.result;
   const double wanted = std::floor(double(result.input_triangles) / settings.ratio);
   if (wanted < 4)
     throw std::invalid_argument(fmt::format(
         "ratio {} leaves {} of {} triangles; a closed proxy needs at least 4 (a ratio of at most {})", settings.ratio,
         wanted, result.input_triangles, double(result.input_triangles) / 4));
   result.target_triangles = static_cast<size_t>(wanted);
-
-  result.scale_m = meshopt_simplifyScale(welded.positions.data(), welded.vertex_count(), 3 * sizeof(float));
 
   const size_t target_indices = 3 * result.target_triangles;
   std::vector<uint32_t> simplified(welded.indices.size());
@@ -190,19 +225,31 @@ MeshSimplifyResult simplify_mesh(const Mesh& mesh, const MeshSimplifySettings& s
                                          result.target_triangles));
   simplified.resize(count);
   result.error = error;
+  finish_simplify(mesh, welded, simplified, settings.normals, result, start);
+  return result;
+}
 
-  WeldedMesh simplified_welded{welded.positions, simplified, {}};
-  result.output_unpaired_edges = count_unpaired_edges(simplified_welded);
-
-  std::vector<SimplifyRgba> colours;
-  const std::vector<uint32_t> part_colour = colour_of_parts(mesh, colours);
-  std::vector<uint32_t> colour_of_triangle = triangle_colours(welded, part_colour, simplified);
-  std::vector<bool> used(colours.size(), false);
-  for (uint32_t t : welded.triangle_part) used[part_colour[t]] = true;
-  result.colours = static_cast<size_t>(std::count(used.begin(), used.end(), true));
-  result.mesh = build_simplified_mesh(welded, simplified, colour_of_triangle, colours, settings.normals);
-  result.mesh.source = mesh.source;
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+MeshSimplifyResult simplify_mesh_within_error(const Mesh& mesh, double max_error, ProxyNormals normals,
+                                              double weld_tolerance) {
+  const auto start = std::chrono::steady_clock::now();
+  if (!(std::isfinite(max_error) && max_error > 0))
+    throw std::invalid_argument(fmt::format("max_error {} is not a finite number above 0", max_error));
+  if (!(std::isfinite(weld_tolerance) && weld_tolerance > 0))
+    throw std::invalid_argument(fmt::format("weld_tolerance {} is not a finite number above 0", weld_tolerance));
+  SimplifyStart begun = start_simplify(mesh, weld_tolerance);
+  const WeldedMesh& welded = begun.welded;
+  MeshSimplifyResult& result = begun.result;
+  std::vector<uint32_t> simplified(welded.indices.size());
+  float error = 0;
+  // Target: none (0 indices), so that only the error bound stops it.
+  const size_t count = meshopt_simplify(simplified.data(), welded.indices.data(), welded.indices.size(),
+                                        welded.positions.data(), welded.vertex_count(), 3 * sizeof(float), 0,
+                                        static_cast<float>(max_error), 0, &error);
+  if (count == 0) throw std::runtime_error(fmt::format("{}: meshoptimizer left no triangle", mesh.source));
+  simplified.resize(count);
+  result.target_triangles = count / 3;
+  result.error = error;
+  finish_simplify(mesh, welded, simplified, normals, result, start);
   return result;
 }
 

@@ -60,4 +60,10 @@ struct MeshSimplifyResult {
 // positive) and std::runtime_error when even meshopt_simplifySloppy cannot reach the target.
 MeshSimplifyResult simplify_mesh(const Mesh& mesh, const MeshSimplifySettings& settings);
 
+// As far as meshopt_simplify goes while the surface moves by at most max_error (a fraction of the
+// mesh's size, as above), with no triangle target: an occluder's coarser levels of detail. The
+// result's target_triangles is what it reached; its method is within_error_bound. Throws as above.
+MeshSimplifyResult simplify_mesh_within_error(const Mesh& mesh, double max_error,
+                                              ProxyNormals normals = ProxyNormals::flat, double weld_tolerance = 1e-6);
+
 }  // namespace arpipe

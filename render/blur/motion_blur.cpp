@@ -47,7 +47,7 @@ void MotionBlurDrawer::prepare(BlurMethod method) {
 void MotionBlurDrawer::draw_at(VirtualLayer& layer, const LayerDrawRequest& request, double exposure_fraction) {
   layer.begin(request.rect);
   const std::vector<ObjectAtInstant> objects = objects_at(request, exposure_fraction);
-  objects_.draw(request.lens, request.rows, request.lighting, objects, request.rect);
+  objects_.draw(request.lens, request.rows, request.lighting, objects, request.rect, request.occluder_lod_px);
   layer.resolve(request.rect);
 }
 

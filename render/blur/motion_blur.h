@@ -36,6 +36,7 @@ struct LayerDrawRequest {
   double image_motion_px = 0;              // ShutterMotion::max_image_motion_px
   int msaa_samples = 4;
   bool rolling_shutter = true;
+  double occluder_lod_px = 0;              // render.occluder_lod_px
 };
 
 struct LayerDrawResult {

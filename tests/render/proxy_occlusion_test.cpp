@@ -5,10 +5,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <numbers>
 #include <optional>
 
+#include "core/scene/builtin_meshes.h"
+#include "core/scene/glb_writer.h"
 #include "render_test_support.h"
 
 namespace arpipe {
@@ -219,6 +223,53 @@ TEST(Proxies, OcclusionEdgeIsAntialiasedWithinAFractionOfAPixel) {
             << " px^2, mean displacement " << displacement << " px\n";
   EXPECT_GT(truth.edge_length_px, 200);
   EXPECT_LE(displacement, 0.5);
+}
+
+// A finely tessellated proxy (a 420-segment cylinder of 9240 triangles, slivers on its side) is
+// drawn depth-only from a coarser level (core/scene/occluder_levels.h): at the default
+// render.occluder_lod_px (0.1) its outline stays within that of the full mesh's, and a tolerance of
+// 10 px draws a visibly coarser one (so the levels are really what is drawn).
+TEST(Proxies, CoarserOccluderLevelsHideWithinTheirTolerance) {
+  const std::filesystem::path dir = std::filesystem::path(ARPIPE_BINARY_DIR) / "proxy-occlusion-test";
+  std::filesystem::create_directories(dir);
+  const std::filesystem::path glb = dir / "can-420.glb";
+  {
+    const std::vector<uint8_t> bytes = encode_glb(make_cylinder_mesh({0.06, 0.06, 0.20}, 420, 4), "test");
+    std::ofstream(glb, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+  }
+  const SE3 pose = oblique_pose();
+  const auto coverage_with = [&](double lod_px) {
+    Config config = proxy_config(4, ProxyRoles{true, false, false, false});
+    config.render.proxies[0].mesh = glb.string();
+    config.render.proxies[0].position_m = {0.08, -0.14, 0.0};
+    config.render.occluder_lod_px = lod_px;
+    harness().configure(config);
+    FrameContext ctx = make_context(black_frame(), pinhole_camera(), pose);
+    harness().process(ctx);
+    EXPECT_TRUE(ctx.virtual_layer_drawn);
+    std::vector<double> out(size_t(kWidth) * kHeight);
+    for (int y = 0; y < kHeight; ++y)
+      for (int x = 0; x < kWidth; ++x) out[size_t(y) * kWidth + x] = linear_at(ctx.output, x, y);
+    return out;
+  };
+  const std::vector<double> full = coverage_with(0), fine = coverage_with(0.1), coarse = coverage_with(10);
+  // The outlines (the cube's and the can's across it), from the full mesh's coverage: pixels
+  // neither empty nor full; the summed difference over their count is a mean displacement in px.
+  double fine_difference = 0, coarse_difference = 0;
+  int edge_pixels = 0;
+  for (size_t i = 0; i < full.size(); ++i) {
+    fine_difference += std::abs(fine[i] - full[i]);
+    coarse_difference += std::abs(coarse[i] - full[i]);
+    edge_pixels += full[i] > 0.02 && full[i] < 0.98;
+  }
+  const double fine_px = fine_difference / edge_pixels, coarse_px = coarse_difference / edge_pixels;
+  std::cout << edge_pixels << " edge pixels; mean displacement against the full mesh: " << fine_px
+            << " px at 0.1 px, " << coarse_px << " px at 10 px\n";
+  EXPECT_GT(edge_pixels, 100);
+  // 0.1 canvas px of tolerance plus MSAA's own quantisation (1/8 px along an edge).
+  EXPECT_LE(fine_px, 0.1 + 0.125);
+  EXPECT_GT(coarse_px, fine_px);
+  EXPECT_LE(coarse_px, 10.0);
 }
 
 // A proxy that only collides draws nothing; one that only occludes leaves the camera's pixels
