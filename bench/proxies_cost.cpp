@@ -91,27 +91,32 @@ int run_proxies_benchmark(const fs::path& capture, const fs::path& config_path, 
                 "the occluders' share | of which the hidden-share report | edge error, still frames (mean / worst) | "
                 "edge error, blurred frames (mean / worst) |\n");
     std::printf("|---|---|---|---|---|---|---|---|---|\n");
-    double no_proxies_ms = 0;
     for (const ProxyVariant& row : rows) {
       Config config = base;
       config.render.proxies = row.proxies;
       if (row.lod_px) config.render.occluder_lod_px = *row.lod_px;
       const bench::ProxyCaptureRun lit = bench::run_proxy_capture(capture, config, repeats);
-      // The occluder pass alone: the same proxies with the one role, the config's shadows on.
-      Config occluding = config;
+      // The occluder pass alone: the same proxies with the one role, the config's shadows on,
+      // against no proxies, in alternating runs so that the machine's drift cancels.
+      Config occluding = config, without = config;
+      without.render.proxies.clear();
       for (SceneProxy& proxy : occluding.render.proxies) {
         proxy.roles.occlude = true;
         proxy.roles.receive_shadows = proxy.roles.cast_shadows = false;
       }
-      const bench::ProxyCaptureRun hiding = row.proxies.empty() ? lit : bench::run_proxy_capture(capture, occluding, repeats);
-      if (row.proxies.empty()) no_proxies_ms = lit.render_ms;
+      std::vector<double> hiding_ms, shares;
+      if (!row.proxies.empty())
+        for (int k = 0; k < std::max(3, repeats); ++k) {
+          const double none = bench::run_proxy_capture(capture, without, 1).render_ms;
+          hiding_ms.push_back(bench::run_proxy_capture(capture, occluding, 1).render_ms);
+          shares.push_back((hiding_ms.back() - none) / hiding_ms.back());
+        }
       config.render.shadows.method = ShadowMethod::Off;
       const bench::ProxyCaptureRun plain = bench::run_proxy_capture(capture, config, repeats);
-      const std::string share =
-          row.proxies.empty() ? std::string("-")
-                              : fmt::format("{:.0f} %", 100.0 * (hiding.render_ms - no_proxies_ms) / hiding.render_ms);
+      const std::string share = shares.empty() ? std::string("-") : fmt::format("{:.0f} %", 100.0 * bench::median_of(shares));
+      const double hiding = hiding_ms.empty() ? lit.render_ms : bench::median_of(hiding_ms);
       std::printf("| %s | %zu | %.2f | %.2f | %.2f | %s | %.2f | %.3f / %.3f px | %.3f / %.3f px |\n", row.label.c_str(),
-                  row.triangles, plain.render_ms, lit.render_ms, hiding.render_ms, share.c_str(), lit.occlusion_ms,
+                  row.triangles, plain.render_ms, lit.render_ms, hiding, share.c_str(), lit.occlusion_ms,
                   plain.mean_still_px, plain.worst_still_px, plain.mean_blurred_px, plain.worst_blurred_px);
       std::fflush(stdout);
     }

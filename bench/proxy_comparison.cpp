@@ -16,13 +16,14 @@
 #include "render/gl_stages.h"
 
 namespace arpipe::bench {
-namespace {
 
 double median_of(std::vector<double> values) {
   if (values.empty()) return 0;
   std::nth_element(values.begin(), values.begin() + long(values.size() / 2), values.end());
   return values[values.size() / 2];
 }
+
+namespace {
 
 // The frame's camera motion from the ground truth, as the motion stage would give it exactly.
 ShutterMotion motion_from_truth(const FrameMetadata& meta, const GroundTruthFrame& truth, int rows) {

@@ -42,6 +42,9 @@ struct ProxyCaptureRun {
 // Draws the capture `repeats` times with `config` (its source is not used; set its shadows to
 // "off" to measure coverage: the layer's alpha is then the objects' alone). Throws on a capture
 // without coverage, or a frame the stages do not draw.
+// The middle value (the upper of the two for an even count); 0 for none.
+double median_of(std::vector<double> values);
+
 ProxyCaptureRun run_proxy_capture(const std::filesystem::path& capture, const Config& config, int repeats = 1);
 
 }  // namespace arpipe::bench
