@@ -79,6 +79,15 @@ vec3 sh9_at(vec3 c[9], vec3 n) {{
 
 vec3 ambient_at(vec3 n) {{ return u_ambient + sh9_at(u_ambient_sh, n); }}
 
+// A real surface's ambient: the constant ambient is a sky above the ground, seen over
+// (1 + n_z) / 2 of a plane's cosine-weighted view, the lit ground over the rest.
+uniform bool u_ambient_is_sky;
+uniform vec3 u_ground_radiance;
+vec3 real_ambient_at(vec3 n) {{
+  if (!u_ambient_is_sky) return ambient_at(n);
+  return u_ambient * (0.5 + 0.5 * n.z) + u_ground_radiance * (0.5 - 0.5 * n.z) + sh9_at(u_ambient_sh, n);
+}}
+
 // The share of a surface's ambient irradiance that the virtual objects hide: a sphere of radius r
 // at distance d in direction w, a above the horizon, covers pi (r / d)^2 of solid angle, so it
 // hides pi (r / d)^2 cos(a) L(w) of E(n) = pi ambient_at(n): (r / d)^2 cos(a) for a uniform sky
@@ -111,7 +120,7 @@ void main() {{
     // without it, where the real casters already shade it as they do in the picture. One ratio
     // for all channels (the layer has one alpha), by luminance.
     const vec3 luma = vec3(0.2126, 0.7152, 0.0722);
-    float ambient = max(dot(ambient_at(normal), luma), 0.0);
+    float ambient = max(dot(real_ambient_at(normal), luma), 0.0);
     float direct = dot(u_light_color, luma) * lambert;
     float real_direct = direct * real_visibility;
     float occlusion = sky_occlusion(v_world, normal, ambient);
@@ -346,6 +355,8 @@ void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, c
   if (sky_occluders > 0 && location("u_sky_occluders") >= 0)
     glUniform4fv(location("u_sky_occluders"), sky_occluders, lighting.sky_occluders[0].data());
   if (location("u_catcher_patch") >= 0) glUniform4fv(location("u_catcher_patch"), 1, lighting.catcher_patch.data());
+  if (location("u_ambient_is_sky") >= 0) glUniform1i(location("u_ambient_is_sky"), lighting.ambient_is_sky ? 1 : 0);
+  if (location("u_ground_radiance") >= 0) set_vec3(location("u_ground_radiance"), lighting.ground_radiance);
   const GLint ground_catcher = location("u_ground_catcher");
   const GLint world_from_object_rotation = program.uniform("u_world_from_object_rotation");
   const GLint world_from_object_translation = program.uniform("u_world_from_object_translation");

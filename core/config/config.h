@@ -390,6 +390,11 @@ struct ShadowConfig {
   // by default: closer to the truth outdoors (bench shadows), but the ground catcher grows by
   // two of the spheres' radii, and the footprint with it.
   bool sky_occlusion = false;
+  // The real ground's albedo, for the light it bounces onto tilted real surfaces (proxies that
+  // catch shadows) under the config's constant ambient, which is a sky above the ground: a face
+  // tilted by t from up sees the sky over (1 + cos t) / 2 of its view and the lit ground over the
+  // rest. An estimated light's SH already holds what the ground sends.
+  double ground_albedo = 0.2;
 
   bool operator==(const ShadowConfig&) const = default;
 };
@@ -409,6 +414,8 @@ void visit(V& v, ShadowConfig& s) {
   v.key("light_angular_diameter_deg", s.light_angular_diameter_deg, NumberRange::closed_open(0, 90).in("degrees"),
         "size of the fixed light (pcss); estimates bring their own");
   v.key("sky_occlusion", s.sky_occlusion, "the objects also hide ambient light from the real surfaces beside them (costs footprint)");
+  v.key("ground_albedo", s.ground_albedo, NumberRange::closed(0, 1),
+        "the real ground's: the light it bounces onto tilted real surfaces that catch shadows, under a constant ambient");
 }
 
 // The precomputed radiance transfer bake (render/prt): run once per mesh and kept in a cache
