@@ -80,11 +80,10 @@ vec3 sh9_at(vec3 c[9], vec3 n) {{
 vec3 ambient_at(vec3 n) {{ return u_ambient + sh9_at(u_ambient_sh, n); }}
 
 // A real surface's ambient: the constant ambient is a sky above the ground, seen over
-// (1 + n_z) / 2 of a plane's cosine-weighted view, the lit ground over the rest.
-uniform bool u_ambient_is_sky;
+// (1 + n_z) / 2 of a plane's cosine-weighted view, the lit ground over the rest. An estimate has
+// neither (its SH holds both), so this is ambient_at for it.
 uniform vec3 u_ground_radiance;
 vec3 real_ambient_at(vec3 n) {{
-  if (!u_ambient_is_sky) return ambient_at(n);
   return u_ambient * (0.5 + 0.5 * n.z) + u_ground_radiance * (0.5 - 0.5 * n.z) + sh9_at(u_ambient_sh, n);
 }}
 
@@ -355,7 +354,6 @@ void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, c
   if (sky_occluders > 0 && location("u_sky_occluders") >= 0)
     glUniform4fv(location("u_sky_occluders"), sky_occluders, lighting.sky_occluders[0].data());
   if (location("u_catcher_patch") >= 0) glUniform4fv(location("u_catcher_patch"), 1, lighting.catcher_patch.data());
-  if (location("u_ambient_is_sky") >= 0) glUniform1i(location("u_ambient_is_sky"), lighting.ambient_is_sky ? 1 : 0);
   if (location("u_ground_radiance") >= 0) set_vec3(location("u_ground_radiance"), lighting.ground_radiance);
   const GLint ground_catcher = location("u_ground_catcher");
   const GLint world_from_object_rotation = program.uniform("u_world_from_object_rotation");

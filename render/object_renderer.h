@@ -30,10 +30,9 @@ struct Lighting {
   Vec3 position{0, 0, 0};
   Vec3 color{1, 1, 1};
   Vec3 ambient{0, 0, 0};
-  // The constant ambient is a sky above the real ground (the config's fixed light): a real
-  // surface that catches shadows takes it over the part of its view above the horizon,
-  // (1 + n_z) / 2, and ground_radiance over the rest. Off for an estimate, whose SH holds both.
-  bool ambient_is_sky = false;
+  // The constant ambient (the config's fixed light) is a sky above the real ground: a real surface
+  // that catches shadows takes it over the part of its view above the horizon, (1 + n_z) / 2, and
+  // ground_radiance over the rest. Both 0 for an estimate, whose SH holds sky and ground.
   Vec3 ground_radiance{0, 0, 0};  // albedo x (direct + sky) irradiance / pi of the lit ground
   std::array<Vec3, 9> ambient_sh{};
   std::array<Vec3, 9> radiance_sh{};  // the ambient light as radiance SH (world), for PRT
@@ -41,7 +40,7 @@ struct Lighting {
   const ShadowLookup* shadow = nullptr;  // nullptr: nothing is shadowed
   // The real casters' own map (proxies with cast_shadows); nullptr: none. The catcher's ratio is
   // (ambient (1 - sky occlusion) + visibility * direct) / (ambient + real visibility * direct),
-  // its ambient as ambient_is_sky says.
+  // its ambient as ground_radiance says.
   const ShadowLookup* real_shadow = nullptr;
   // The virtual objects that hide part of the sky from the catchers: spheres of their mean
   // projected area (x, y, z world, radius), at most kMaxSkyOccluders (the rest are left out).

@@ -380,7 +380,6 @@ Lighting RenderStage::frame_lighting(const FrameContext& ctx, double& angular_di
     lighting.position = settings_.light_distance_m * settings_.light_direction;
     // The ground, lit by the light (irradiance / pi = colour x cos) and the sky (L), sends
     // albedo times that; the light's direction from the anchor serves a lamp too.
-    lighting.ambient_is_sky = true;
     lighting.ground_radiance =
         settings_.shadows.ground_albedo *
         (std::max(settings_.light_direction[2], 0.0) * settings_.light_color + settings_.ambient);

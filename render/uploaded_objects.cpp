@@ -179,17 +179,14 @@ std::vector<UploadedObject> upload_proxies(const Config& config, const LoadedMes
     object.writes_depth = proxy.roles.occlude;
     object.casts_shadows = proxy.roles.cast_shadows;
     object.base_color = std::array<float, 4>{0, 0, 0, 0};
-    for (const OccluderLevel& level : loaded.proxies[i].occluder_levels)
-    {
+    std::string sizes;
+    for (const OccluderLevel& level : loaded.proxies[i].occluder_levels) {
       object.occluder_levels.push_back(std::make_shared<const GpuMesh>(*level.mesh));
       object.occluder_level_errors_m.push_back(level.error * proxy.scale);
+      sizes += fmt::format(", {} ({:.2g} mm)", level.mesh->triangle_count(), 1e3 * object.occluder_level_errors_m.back());
     }
-    if (!object.occluder_levels.empty()) {
-      std::string sizes;
-      for (const OccluderLevel& level : loaded.proxies[i].occluder_levels)
-        sizes += fmt::format(", {} ({:.2g} mm)", level.mesh->triangle_count(), 1e3 * level.error * proxy.scale);
+    if (!sizes.empty())
       log::info("proxy {}: occluder levels of {} triangles{}", object.name, loaded.proxies[i].mesh->triangle_count(), sizes);
-    }
     out.push_back(std::move(object));
   }
   return out;
