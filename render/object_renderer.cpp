@@ -314,22 +314,8 @@ const GpuMesh* occluder_level_for(const ObjectAtInstant& item, const LensUniform
 
 }  // namespace
 
-void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, const Lighting& lighting,
-                          std::span<const ObjectAtInstant> objects, const PixelRect& cull_rect, double occluder_lod_px) {
-  const ShadowMethod method = lighting.shadow ? lighting.shadow->method : ShadowMethod::Off;
-  const bool real = lighting.shadow && lighting.real_shadow;
-  const GlProgram& program = shading(method, real);
-  set_depth_state();
-  // A proxy shades only to catch a shadow; without one this frame it hides (depth only) or is
-  // not drawn at all.
-  const auto shades = [&](const UploadedObject& object) { return !object.proxy || (object.shadow_catcher && lighting.shadow); };
-  const bool any_occluder = std::any_of(objects.begin(), objects.end(), [&](const ObjectAtInstant& item) {
-    return !shades(*item.object) && item.object->writes_depth;
-  });
-  if (any_occluder) {
-    set_lens_uniforms(occluder_, lens);
-    set_row_projection(occluder_, rows);
-  }
+void ObjectRenderer::set_frame_uniforms(const GlProgram& program, const LensUniforms& lens, const RowProjection& rows,
+                                        const Lighting& lighting) const {
   set_lens_uniforms(program, lens);  // binds the program
   set_row_projection(program, rows);
   set_vec3(program.uniform("u_light_direction"), lighting.direction);
@@ -345,26 +331,51 @@ void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, c
     for (size_t c = 0; c < 3; ++c) sh[i * 3 + c] = static_cast<float>(lighting.radiance_sh[i][c]);
   glUniform3fv(program.uniform("u_radiance_sh"), 9, sh.data());
   glUniform1f(program.uniform("u_exposure_scale"), static_cast<float>(lighting.exposure_scale));
-  if (lighting.shadow) set_shadow_lookup_uniforms(program, *lighting.shadow, 1);
-  // Without shadows the catcher never runs and the compiler drops these: set only those it kept.
+  // The compiler drops the uniforms a program does not read (the lookups of a program without
+  // them, the catcher's of one that never runs it): set only those it kept.
   const auto location = [&](const char* name) { return glGetUniformLocation(program.id(), name); };
-  if (real) set_shadow_lookup_uniforms(program, *lighting.real_shadow, 2, "real_");
+  if (lighting.shadow && location("u_shadow_map") >= 0) set_shadow_lookup_uniforms(program, *lighting.shadow, 1);
+  if (lighting.shadow && lighting.real_shadow && location("real_u_shadow_map") >= 0)
+    set_shadow_lookup_uniforms(program, *lighting.real_shadow, 2, "real_");
   const int sky_occluders = static_cast<int>(std::min(lighting.sky_occluders.size(), Lighting::kMaxSkyOccluders));
   if (location("u_sky_occluder_count") >= 0) glUniform1i(location("u_sky_occluder_count"), sky_occluders);
   if (sky_occluders > 0 && location("u_sky_occluders") >= 0)
     glUniform4fv(location("u_sky_occluders"), sky_occluders, lighting.sky_occluders[0].data());
   if (location("u_catcher_patch") >= 0) glUniform4fv(location("u_catcher_patch"), 1, lighting.catcher_patch.data());
   if (location("u_ground_radiance") >= 0) set_vec3(location("u_ground_radiance"), lighting.ground_radiance);
-  const GLint ground_catcher = location("u_ground_catcher");
-  const GLint world_from_object_rotation = program.uniform("u_world_from_object_rotation");
-  const GLint world_from_object_translation = program.uniform("u_world_from_object_translation");
-  const GLint object_scale = program.uniform("u_object_scale");
-  const GLint base_color = program.uniform("u_base_color");
-  const GLint shadow_catcher = program.uniform("u_shadow_catcher");
-  const GLint prt = program.uniform("u_prt");
-  const GLint specular = program.uniform("u_specular");
-  const GLint camera_world = program.uniform("u_camera_world");
-  const GLint prt_light = program.uniform("u_prt_light");
+}
+
+void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, const Lighting& lighting,
+                          std::span<const ObjectAtInstant> objects, const PixelRect& cull_rect, double occluder_lod_px) {
+  const ShadowMethod method = lighting.shadow ? lighting.shadow->method : ShadowMethod::Off;
+  const bool real = lighting.shadow && lighting.real_shadow;
+  set_depth_state();
+  // A proxy shades only to catch a shadow; without one this frame it hides (depth only) or is
+  // not drawn at all.
+  const auto shades = [&](const UploadedObject& object) { return !object.proxy || (object.shadow_catcher && lighting.shadow); };
+  const auto unshadowed = [&](const UploadedObject& object) {
+    return std::find(lighting.unshadowed.begin(), lighting.unshadowed.end(), &object) != lighting.unshadowed.end();
+  };
+  const bool any_occluder = std::any_of(objects.begin(), objects.end(), [&](const ObjectAtInstant& item) {
+    return !shades(*item.object) && item.object->writes_depth;
+  });
+  if (any_occluder) {
+    set_lens_uniforms(occluder_, lens);
+    set_row_projection(occluder_, rows);
+  }
+  // The programs this draw uses, each given the frame's uniforms on first use.
+  const GlProgram* with_lookups = nullptr;
+  const GlProgram* without_lookups = nullptr;
+  const auto program_for = [&](const UploadedObject& object) -> const GlProgram& {
+    const bool plain = method == ShadowMethod::Off || unshadowed(object);
+    const GlProgram*& program = plain ? without_lookups : with_lookups;
+    if (!program) {
+      program = plain ? &shading(ShadowMethod::Off, false) : &shading(method, real);
+      set_frame_uniforms(*program, lens, rows, lighting);
+    }
+    glUseProgram(program->id());
+    return *program;
+  };
   for (const ObjectAtInstant& item : objects) {
     if (!shades(*item.object)) {
       if (!item.object->writes_depth) continue;
@@ -373,30 +384,33 @@ void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, c
       glDepthMask(GL_TRUE);
       if (const GpuMesh* level = occluder_level_for(item, lens, occluder_lod_px)) level->draw([](const MeshPart&) {});
       else draw_mesh(item, lens, cull_rect, [](const MeshPart&) {});
-      glUseProgram(program.id());
       continue;
     }
+    const GlProgram& program = program_for(*item.object);
     set_row_poses(program, "pose", item.poses, item.object->scale);
     const std::array<float, 9> rotation = column_major(item.object->T_world_object.rotation());
-    glUniformMatrix3fv(world_from_object_rotation, 1, GL_FALSE, rotation.data());
-    set_vec3(world_from_object_translation, item.object->T_world_object.translation());
-    glUniform1f(object_scale, static_cast<float>(item.object->scale));
-    glUniform1i(shadow_catcher, item.object->shadow_catcher ? 1 : 0);
+    glUniformMatrix3fv(program.uniform("u_world_from_object_rotation"), 1, GL_FALSE, rotation.data());
+    set_vec3(program.uniform("u_world_from_object_translation"), item.object->T_world_object.translation());
+    glUniform1f(program.uniform("u_object_scale"), static_cast<float>(item.object->scale));
+    glUniform1i(program.uniform("u_shadow_catcher"), item.object->shadow_catcher ? 1 : 0);
+    const GLint ground_catcher = glGetUniformLocation(program.id(), "u_ground_catcher");
     if (ground_catcher >= 0) glUniform1i(ground_catcher, item.object->shadow_catcher && !item.object->proxy ? 1 : 0);
     glDepthMask(item.object->writes_depth ? GL_TRUE : GL_FALSE);
-    glUniform1f(specular, item.object->shadow_catcher || item.object->proxy ? 0.0f : static_cast<float>(item.object->specular));
+    glUniform1f(program.uniform("u_specular"),
+                item.object->shadow_catcher || item.object->proxy ? 0.0f : static_cast<float>(item.object->specular));
     if (item.object->specular > 0 && !item.poses.T_cam_object.empty()) {
       // The eye of the middle row: rows differ by far less than the reflection's blur.
       const SE3& T_cam_object = item.poses.T_cam_object[item.poses.T_cam_object.size() / 2];
-      set_vec3(camera_world, item.object->T_world_object * T_cam_object.inverse().translation());
+      set_vec3(program.uniform("u_camera_world"), item.object->T_world_object * T_cam_object.inverse().translation());
     }
     const bool use_prt = item.object->mesh->has_transfer() && !item.object->shadow_catcher && !item.object->proxy;
-    glUniform1i(prt, use_prt ? 1 : 0);
+    glUniform1i(program.uniform("u_prt"), use_prt ? 1 : 0);
     if (use_prt) {
       // The transfer lives in the object's frame: turn the world's light into it.
       const std::array<float, 27> light = object_frame_light(lighting.radiance_sh, item.object->T_world_object.rotation());
-      glUniform3fv(prt_light, 9, light.data());
+      glUniform3fv(program.uniform("u_prt_light"), 9, light.data());
     }
+    const GLint base_color = program.uniform("u_base_color");
     draw_mesh(item, lens, cull_rect, [&](const MeshPart& part) {
       const std::array<float, 4>& color = item.object->base_color ? *item.object->base_color : part.base_color;
       glUniform4f(base_color, color[0], color[1], color[2], color[3]);

@@ -49,6 +49,9 @@ struct Lighting {
   // The ground catcher's square (world x, y min and max), towards whose edge the sky occlusion
   // fades to 0 so that no seam shows where the catcher ends.
   std::array<float, 4> catcher_patch{};
+  // The objects no shadow reaches this frame (render/shadow/unshadowed_objects.h): drawn without
+  // the shadow lookups, which would all return 1 on them.
+  std::vector<const UploadedObject*> unshadowed;
 };
 
 struct ObjectAtInstant {
@@ -89,6 +92,9 @@ class ObjectRenderer {
  private:
   // real_shadow: with the real casters' map (proxies that cast), else its lookup is a constant 1.
   const GlProgram& shading(ShadowMethod method, bool real_shadow);
+  // Binds the program and sets what every item drawn with it shares: lens, rows and light.
+  void set_frame_uniforms(const GlProgram& program, const LensUniforms& lens, const RowProjection& rows,
+                          const Lighting& lighting) const;
   std::map<std::pair<ShadowMethod, bool>, GlProgram> shading_;  // one per shadow lookup
   GlProgram velocity_;
   GlProgram occluder_;  // proxies that hide but catch no shadow: depth only

@@ -104,7 +104,10 @@ void RenderStage::configure_loaded(const Config& config, const std::shared_ptr<c
   } else if (!shadow_pass_ || shadow_pass_->config() != settings.shadows) {
     shadow_pass_ = std::make_unique<ShadowMapPass>(session_->context(), settings.shadows);
   }
-  if (!receiver_) receiver_ = std::make_unique<ShadowReceiver>();
+  // Split so that lens distortion applied per vertex bends it like the ground in the image.
+  const int receiver_subdivisions = settings.lens == LensMode::Vertex ? 16 : 1;
+  if (!receiver_ || receiver_->subdivisions() != receiver_subdivisions)
+    receiver_ = std::make_unique<ShadowReceiver>(receiver_subdivisions);
   // The real casters' map: a depth map for the catcher's real visibility (shadow_lookup_glsl.h).
   const bool real_casters = std::any_of(proxies.begin(), proxies.end(), [](const UploadedObject& p) { return p.casts_shadows; });
   // The same method and size as the main map, so that where no virtual object casts, the two
@@ -487,6 +490,8 @@ const ShadowLookup* RenderStage::shadow_for(FrameContext& ctx, Lighting& lightin
     lighting.real_shadow = &real_shadow_pass_->lookup();
   }
   drawn.push_back(&catcher);
+  lighting.unshadowed = unshadowed_objects(caster_objects, *frustum, settings_.shadow_method,
+                                           shadow_lookup_reach_m(shadow_pass_->lookup(), *frustum));
   redrawn = drew;
   if (drew) glFinish();  // honest timings: the work is queued until something waits
   ctx.record_timing("shadow", milliseconds_since(start), drew ? "" : "reused");

@@ -21,6 +21,7 @@
 #include "render/occlusion_meter.h"
 #include "render/shadow/shadow_map.h"
 #include "render/shadow/shadow_receiver.h"
+#include "render/shadow/unshadowed_objects.h"
 
 namespace arpipe {
 

@@ -13,6 +13,7 @@
 #include "core/scene/asset_error.h"
 #include "core/scene/builtin_meshes.h"
 #include "core/scene/gltf_loader.h"
+#include "core/scene/mesh_convexity.h"
 #include "render/prt/prt_cache.h"
 #include "render/proxy_clusters.h"
 
@@ -42,13 +43,19 @@ Mesh load_mesh(const Config& config, const std::string& key, const std::string& 
   }
 }
 
+// Builtin faces are split only where the lens is applied per vertex (render.lens = "vertex": long
+// edges must bend with it). A rolling shutter's skew is linear in the row to first order, which a
+// whole face follows between its corners; and a software rasteriser shades whole 4 x 4 blocks
+// along every triangle edge, so an 8 x 8 split of a cube's faces costs about half its shading time.
+int builtin_subdivisions(const Config& config) { return config.render.lens == LensMode::Vertex ? 8 : 1; }
+
 // A proxy's mesh must have triangles: one without hides and catches nothing, which is never meant.
 // A proxy is never shaded, so a builtin's faces are split only where the lens is applied per
 // vertex (render.lens = "vertex": long edges must bend with it); otherwise a box is 12 triangles,
 // which matters on a software rasteriser (about a microsecond per triangle drawn).
 std::shared_ptr<const Mesh> load_proxy_mesh(const Config& config, const std::string& key, const std::string& source,
                                             const Vec3& size_m) {
-  Mesh mesh = load_mesh(config, key, source, size_m, config.render.lens == LensMode::Vertex ? 8 : 1);
+  Mesh mesh = load_mesh(config, key, source, size_m, builtin_subdivisions(config));
   if (mesh.triangle_count() == 0)
     throw AssetError(fmt::format("{}: {} = \"{}\": the mesh has no triangles", config_name(config), key, source));
   return std::make_shared<const Mesh>(std::move(mesh));
@@ -125,8 +132,10 @@ LoadedMeshes load_object_meshes(const Config& config) {
     auto found = index_of.find(key);
     if (found == index_of.end()) {
       LoadedMeshes::Entry entry;
-      entry.mesh = load_mesh(config, fmt::format("render.objects[{}].mesh", i), object.mesh);
+      entry.mesh = load_mesh(config, fmt::format("render.objects[{}].mesh", i), object.mesh, {0.06, 0.06, 0.06},
+                             builtin_subdivisions(config));
       entry.transfer = transfer_for(config, i, object.mesh, entry.mesh, object.prt);
+      entry.closed_convex = is_closed_convex(entry.mesh);
       loaded.meshes.push_back(std::move(entry));
       found = index_of.emplace(key, loaded.meshes.size() - 1).first;
     }
@@ -210,6 +219,7 @@ std::vector<UploadedObject> upload_objects(const Config& config, const LoadedMes
     out.specular = object.specular;
     out.bounds = scaled(loaded.meshes[m].mesh.bounds(), object.scale);
     out.sky_radius_m = object.scale * mean_projected_radius(loaded.meshes[m].mesh);
+    out.closed_convex = loaded.meshes[m].closed_convex;
     out.T_world_object = SE3::from_rt({0, 0, object.yaw_rad}, object.position_m);
     if (is_builtin_mesh_source(object.mesh))
       out.base_color = std::array<float, 4>{static_cast<float>(object.color[0]), static_cast<float>(object.color[1]),

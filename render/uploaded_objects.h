@@ -41,6 +41,9 @@ struct UploadedObject {
   // The radius of a sphere with the object's mean projected area (a convex body's is a quarter of
   // its surface), scaled: how much sky it hides from the ground beside it (object_renderer.h).
   double sky_radius_m = 0;
+  // Its mesh bounds a convex solid (core/scene/mesh_convexity.h): it cannot shadow itself where it
+  // faces the light (render/shadow/unshadowed_objects.h).
+  bool closed_convex = false;
   // A large proxy's culling clusters (render/proxy_clusters.h): per part of its mesh, the part's
   // bounds in the object frame, scaled. Empty: drawn whole.
   std::vector<Bounds> cluster_bounds;
@@ -59,6 +62,7 @@ struct LoadedMeshes {
   struct Entry {
     Mesh mesh;
     std::vector<float> transfer;  // 9 coefficients per vertex, or empty without PRT
+    bool closed_convex = false;   // is_closed_convex(mesh)
   };
   std::vector<Entry> meshes;
   std::vector<size_t> mesh_of_object;  // per render.objects entry: its index in meshes

@@ -230,7 +230,9 @@ bool builtin_mesh_is_sized(std::string_view source) {
 std::optional<Mesh> make_builtin_mesh(std::string_view source, const Vec3& size_m, int subdivisions) {
   subdivisions = std::max(subdivisions, 1);
   std::optional<Mesh> mesh;
-  if (source == "builtin:box") mesh = make_box_mesh(size_m, subdivisions);
+  if (source == "builtin:cube") mesh = make_cube_mesh(0.06, subdivisions);
+  else if (source == "builtin:pyramid") mesh = make_pyramid_mesh(0.06, 0.06, subdivisions);
+  else if (source == "builtin:box") mesh = make_box_mesh(size_m, subdivisions);
   else if (source == "builtin:cylinder") mesh = make_cylinder_mesh(size_m, 48, subdivisions);
   else if (source == "builtin:plane") mesh = make_rectangle_mesh(size_m[0], size_m[1], subdivisions);
   else return make_builtin_mesh(source);

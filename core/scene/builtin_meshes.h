@@ -39,8 +39,9 @@ bool is_builtin_mesh_source(std::string_view source);
 // The builtin mesh a source names, at its default size; nullopt for an unknown builtin name.
 std::optional<Mesh> make_builtin_mesh(std::string_view source);
 // The same, with "builtin:box", "builtin:cylinder" and "builtin:plane" made at size_m (x, y, z;
-// the plane ignores z), their faces split into subdivisions x subdivisions (1: a box of 12
-// triangles, where no lens distortion is applied per vertex); the other builtins ignore both.
+// the plane ignores z), and their faces, "builtin:cube"'s and "builtin:pyramid"'s split into
+// subdivisions x subdivisions (1: a box of 12 triangles, where no lens distortion is applied per
+// vertex); the sphere and the cup ignore both.
 std::optional<Mesh> make_builtin_mesh(std::string_view source, const Vec3& size_m, int subdivisions = 8);
 // Whether a builtin takes its size from size_m.
 bool builtin_mesh_is_sized(std::string_view source);

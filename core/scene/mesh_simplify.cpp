@@ -23,10 +23,6 @@ constexpr float kUnboundedSimplifyError = 1e6f;
 
 using SimplifyRgba = std::array<float, 4>;
 
-Vec3 welded_position(const WeldedMesh& mesh, uint32_t v) {
-  return {mesh.positions[3 * size_t{v}], mesh.positions[3 * size_t{v} + 1], mesh.positions[3 * size_t{v} + 2]};
-}
-
 // Per input part (and one more for triangles in none): its colour's number among the distinct
 // colours, which are listed in `colours`.
 std::vector<uint32_t> colour_of_parts(const Mesh& mesh, std::vector<SimplifyRgba>& colours) {
@@ -90,7 +86,7 @@ Mesh build_simplified_mesh(const WeldedMesh& welded, const std::vector<uint32_t>
         uint32_t& index = new_index[simplified[3 * t + k]];
         if (index != UINT32_MAX) continue;
         index = static_cast<uint32_t>(out.vertex_count());
-        push_simplified_vec3(out.positions, welded_position(welded, simplified[3 * t + k]));
+        push_simplified_vec3(out.positions, welded.position_of(simplified[3 * t + k]));
       }
     smooth_normal.assign(out.vertex_count(), Vec3{0, 0, 0});
   }
@@ -100,7 +96,7 @@ Mesh build_simplified_mesh(const WeldedMesh& welded, const std::vector<uint32_t>
     if (out.parts.empty() || out.parts.back().base_color != colours[colour])
       out.parts.push_back(MeshPart{static_cast<uint32_t>(out.indices.size()), 0, colours[colour]});
     const uint32_t a = simplified[3 * t], b = simplified[3 * t + 1], c = simplified[3 * t + 2];
-    const Vec3 pa = welded_position(welded, a), pb = welded_position(welded, b), pc = welded_position(welded, c);
+    const Vec3 pa = welded.position_of(a), pb = welded.position_of(b), pc = welded.position_of(c);
     const Vec3 area_normal = cross(pb - pa, pc - pa);  // twice the area, outwards for counter-clockwise
     if (normals == ProxyNormals::smooth) {
       for (uint32_t v : {a, b, c}) {

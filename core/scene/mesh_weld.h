@@ -17,6 +17,9 @@ struct WeldedMesh {
 
   size_t vertex_count() const { return positions.size() / 3; }
   size_t triangle_count() const { return indices.size() / 3; }
+  Vec3 position_of(uint32_t v) const {
+    return {positions[3 * size_t{v}], positions[3 * size_t{v} + 1], positions[3 * size_t{v} + 2]};
+  }
 };
 
 // Positions closer than about `tolerance_m` become one vertex (they are snapped to a grid of that

@@ -7,9 +7,8 @@
 
 namespace arpipe {
 
-ShadowReceiver::ShadowReceiver() {
-  // Subdivided so that lens distortion applied per vertex bends it like the ground in the image.
-  object_.mesh = std::make_shared<GpuMesh>(make_plane_mesh(1.0, 16));
+ShadowReceiver::ShadowReceiver(int subdivisions) : subdivisions_(subdivisions) {
+  object_.mesh = std::make_shared<GpuMesh>(make_plane_mesh(1.0, subdivisions));
   object_.mesh_source = "shadow catcher";
   object_.shadow_catcher = true;
   object_.base_color = std::array<float, 4>{0, 0, 0, 1};

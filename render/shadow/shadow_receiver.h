@@ -11,12 +11,16 @@ namespace arpipe {
 
 class ShadowReceiver {
  public:
-  ShadowReceiver();  // uploads the square; needs a current context
+  // Uploads the square, its sides split in subdivisions (for a lens applied per vertex, else 1);
+  // needs a current context.
+  explicit ShadowReceiver(int subdivisions);
+  int subdivisions() const { return subdivisions_; }
   // The catcher over this patch (a square covering it), valid until the next call.
   const UploadedObject& over(const ReceiverPatch& patch);
 
  private:
   UploadedObject object_;
+  int subdivisions_ = 1;
 };
 
 }  // namespace arpipe
