@@ -159,6 +159,55 @@ out vec4 out_color;
 void main() { out_color = vec4(0.0); }
 )glsl";
 
+// The ground catcher's ratio baked over its square (render/shadow/catcher_bake.h): the shading
+// program's fragment shader, its point placed on the bake texture instead of the camera image,
+// so each texel holds what the catcher would draw at that ground point.
+constexpr std::string_view kCatcherBakeVertexShader = R"glsl(#version 300 es
+precision highp float;
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec3 a_normal;
+uniform mat3 u_world_from_object_rotation;
+uniform vec3 u_world_from_object_translation;
+uniform float u_object_scale;
+uniform vec4 u_bake_square;  // world x, y min and max: the texture's extent
+out vec3 v_normal_world;
+out vec3 v_world;
+out vec3 v_prt_radiance;
+
+void main() {
+  v_normal_world = u_world_from_object_rotation * a_normal;
+  v_world = u_world_from_object_rotation * (u_object_scale * a_position) + u_world_from_object_translation;
+  v_prt_radiance = vec3(0.0);
+  gl_Position = vec4(2.0 * (v_world.xy - u_bake_square.xy) / (u_bake_square.zw - u_bake_square.xy) - 1.0, 0.0, 1.0);
+}
+)glsl";
+
+// The ground catcher drawn from its bake: one filtered lookup per pixel instead of the shadow filter.
+constexpr std::string_view kBakedCatcherVertexShader = R"glsl(
+layout(location = 0) in vec3 a_position;
+uniform mat3 u_world_from_object_rotation;  // without the scale
+uniform vec3 u_world_from_object_translation;
+uniform float u_object_scale;
+out vec2 v_ground;  // world x, y
+
+void main() {
+  gl_Position = camera_to_clip(pose_camera_point(a_position));
+  v_ground = (u_world_from_object_rotation * (u_object_scale * a_position) + u_world_from_object_translation).xy;
+}
+)glsl";
+
+constexpr std::string_view kBakedCatcherFragmentShader = R"glsl(#version 300 es
+precision highp float;
+in vec2 v_ground;
+uniform highp sampler2D u_catcher_ratio;  // alpha: 1 - ratio, as the shading program draws it
+uniform vec4 u_bake_square;
+out vec4 out_color;
+
+void main() {
+  out_color = vec4(0.0, 0.0, 0.0, texture(u_catcher_ratio, (v_ground - u_bake_square.xy) / (u_bake_square.zw - u_bake_square.xy)).a);
+}
+)glsl";
+
 constexpr std::string_view kVelocityVertexShader = R"glsl(
 layout(location = 0) in vec3 a_position;
 out vec2 v_motion_px;
@@ -237,26 +286,47 @@ void set_depth_state() {
 
 ObjectRenderer::ObjectRenderer()
     : velocity_("object velocity", vertex_source({"mid", "start", "end"}, kVelocityVertexShader), kVelocityFragmentShader),
-      occluder_("proxy occluder", vertex_source({"pose"}, kOccluderVertexShader), kOccluderFragmentShader) {
+      occluder_("proxy occluder", vertex_source({"pose"}, kOccluderVertexShader), kOccluderFragmentShader),
+      baked_catcher_("baked ground catcher", vertex_source({"pose"}, kBakedCatcherVertexShader), kBakedCatcherFragmentShader) {
   prepare(ShadowMethod::Off);
 }
 
 void ObjectRenderer::prepare(ShadowMethod method) { shading(method, false); }
 
+namespace {
+
+std::string shading_fragment_source(ShadowMethod method, bool real_shadow) {
+  return fmt::format(fmt::runtime(kShadingFragmentShaderTemplate), fmt::arg("shadow_lookup", shadow_lookup_glsl(method)),
+                     fmt::arg("real_shadow_lookup", shadow_lookup_glsl(real_shadow ? method : ShadowMethod::Off, "real_")),
+                     fmt::arg("max_sky_occluders", Lighting::kMaxSkyOccluders));
+}
+
+std::string shading_program_name(std::string_view what, ShadowMethod method, bool real_shadow) {
+  return fmt::format("{} ({} shadows{})", what, shadow_method_name(method), real_shadow ? ", real casters" : "");
+}
+
+}  // namespace
+
 const GlProgram& ObjectRenderer::shading(ShadowMethod method, bool real_shadow) {
   const std::pair<ShadowMethod, bool> key{method, real_shadow};
   auto found = shading_.find(key);
-  if (found == shading_.end()) {
-    const std::string fragment =
-        fmt::format(fmt::runtime(kShadingFragmentShaderTemplate), fmt::arg("shadow_lookup", shadow_lookup_glsl(method)),
-                    fmt::arg("real_shadow_lookup", shadow_lookup_glsl(real_shadow ? method : ShadowMethod::Off, "real_")),
-                    fmt::arg("max_sky_occluders", Lighting::kMaxSkyOccluders));
+  if (found == shading_.end())
     found = shading_
-                .emplace(key, GlProgram(fmt::format("object shading ({} shadows{})", shadow_method_name(method),
-                                                    real_shadow ? ", real casters" : ""),
-                                        vertex_source({"pose"}, kShadingVertexShader), fragment))
+                .emplace(key, GlProgram(shading_program_name("object shading", method, real_shadow),
+                                        vertex_source({"pose"}, kShadingVertexShader),
+                                        shading_fragment_source(method, real_shadow)))
                 .first;
-  }
+  return found->second;
+}
+
+const GlProgram& ObjectRenderer::baking(ShadowMethod method, bool real_shadow) {
+  const std::pair<ShadowMethod, bool> key{method, real_shadow};
+  auto found = baking_.find(key);
+  if (found == baking_.end())
+    found = baking_
+                .emplace(key, GlProgram(shading_program_name("ground catcher bake", method, real_shadow),
+                                        kCatcherBakeVertexShader, shading_fragment_source(method, real_shadow)))
+                .first;
   return found->second;
 }
 
@@ -318,6 +388,11 @@ void ObjectRenderer::set_frame_uniforms(const GlProgram& program, const LensUnif
                                         const Lighting& lighting) const {
   set_lens_uniforms(program, lens);  // binds the program
   set_row_projection(program, rows);
+  set_light_uniforms(program, lighting);
+}
+
+void ObjectRenderer::set_light_uniforms(const GlProgram& program, const Lighting& lighting) const {
+  glUseProgram(program.id());
   set_vec3(program.uniform("u_light_direction"), lighting.direction);
   glUniform4f(program.uniform("u_light_position"), static_cast<float>(lighting.position[0]),
               static_cast<float>(lighting.position[1]), static_cast<float>(lighting.position[2]), lighting.local ? 1.0f : 0.0f);
@@ -376,7 +451,29 @@ void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, c
     glUseProgram(program->id());
     return *program;
   };
+  const auto baked_ground_catcher = [&](const UploadedObject& object) {
+    return object.shadow_catcher && !object.proxy && lighting.shadow && lighting.baked_catcher.texture != 0;
+  };
+  bool baked_catcher_ready = false;
   for (const ObjectAtInstant& item : objects) {
+    if (baked_ground_catcher(*item.object)) {
+      if (!baked_catcher_ready) {
+        set_lens_uniforms(baked_catcher_, lens);
+        set_row_projection(baked_catcher_, rows);
+        glActiveTexture(GL_TEXTURE3);
+        glBindTexture(GL_TEXTURE_2D, lighting.baked_catcher.texture);
+        glActiveTexture(GL_TEXTURE0);
+        glUniform1i(baked_catcher_.uniform("u_catcher_ratio"), 3);
+        glUniform4fv(baked_catcher_.uniform("u_bake_square"), 1, lighting.baked_catcher.square.data());
+        baked_catcher_ready = true;
+      }
+      glUseProgram(baked_catcher_.id());
+      set_row_poses(baked_catcher_, "pose", item.poses, item.object->scale);
+      set_object_placement(baked_catcher_, *item.object);
+      glDepthMask(item.object->writes_depth ? GL_TRUE : GL_FALSE);  // as the per-pixel path
+      item.object->mesh->draw([](const MeshPart&) {});
+      continue;
+    }
     if (!shades(*item.object)) {
       if (!item.object->writes_depth) continue;
       glUseProgram(occluder_.id());
@@ -388,10 +485,7 @@ void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, c
     }
     const GlProgram& program = program_for(*item.object);
     set_row_poses(program, "pose", item.poses, item.object->scale);
-    const std::array<float, 9> rotation = column_major(item.object->T_world_object.rotation());
-    glUniformMatrix3fv(program.uniform("u_world_from_object_rotation"), 1, GL_FALSE, rotation.data());
-    set_vec3(program.uniform("u_world_from_object_translation"), item.object->T_world_object.translation());
-    glUniform1f(program.uniform("u_object_scale"), static_cast<float>(item.object->scale));
+    set_object_placement(program, *item.object);
     glUniform1i(program.uniform("u_shadow_catcher"), item.object->shadow_catcher ? 1 : 0);
     const GLint ground_catcher = glGetUniformLocation(program.id(), "u_ground_catcher");
     if (ground_catcher >= 0) glUniform1i(ground_catcher, item.object->shadow_catcher && !item.object->proxy ? 1 : 0);
@@ -417,6 +511,31 @@ void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, c
     });
   }
   glDepthMask(GL_TRUE);
+}
+
+void ObjectRenderer::bake_ground_catcher(const Lighting& lighting, const UploadedObject& catcher,
+                                         const std::array<float, 4>& square) {
+  const ShadowMethod method = lighting.shadow ? lighting.shadow->method : ShadowMethod::Off;
+  const GlProgram& program = baking(method, lighting.shadow && lighting.real_shadow);
+  set_light_uniforms(program, lighting);  // binds it
+  set_object_placement(program, catcher);
+  glUniform4fv(program.uniform("u_bake_square"), 1, square.data());
+  glUniform1i(program.uniform("u_shadow_catcher"), 1);
+  const GLint ground_catcher = glGetUniformLocation(program.id(), "u_ground_catcher");
+  if (ground_catcher >= 0) glUniform1i(ground_catcher, 1);
+  glDisable(GL_DEPTH_TEST);
+  glDisable(GL_BLEND);
+  glDisable(GL_CULL_FACE);
+  glFrontFace(GL_CCW);  // seen from above with x right and y up, the square winds counter-clockwise
+  catcher.mesh->draw([](const MeshPart&) {});
+  glFrontFace(GL_CW);
+}
+
+void ObjectRenderer::set_object_placement(const GlProgram& program, const UploadedObject& object) const {
+  const std::array<float, 9> rotation = column_major(object.T_world_object.rotation());
+  glUniformMatrix3fv(program.uniform("u_world_from_object_rotation"), 1, GL_FALSE, rotation.data());
+  set_vec3(program.uniform("u_world_from_object_translation"), object.T_world_object.translation());
+  glUniform1f(program.uniform("u_object_scale"), static_cast<float>(object.scale));
 }
 
 void ObjectRenderer::draw_velocity(const LensUniforms& lens, const RowProjection& rows,

@@ -49,6 +49,12 @@ struct Lighting {
   // The ground catcher's square (world x, y min and max), towards whose edge the sky occlusion
   // fades to 0 so that no seam shows where the catcher ends.
   std::array<float, 4> catcher_patch{};
+  // The ground catcher's ratio baked over its square (render/shadow/catcher_bake.h): a texture
+  // whose alpha is what the catcher draws, over world x, y min and max. Texture 0: per pixel.
+  struct BakedCatcher {
+    GLuint texture = 0;
+    std::array<float, 4> square{};
+  } baked_catcher;
   // The objects no shadow reaches this frame (render/shadow/unshadowed_objects.h): drawn without
   // the shadow lookups, which would all return 1 on them.
   std::vector<const UploadedObject*> unshadowed;
@@ -84,6 +90,10 @@ class ObjectRenderer {
   // this far at its nearest point (UploadedObject::occluder_levels); 0: its full mesh.
   void draw(const LensUniforms& lens, const RowProjection& rows, const Lighting& lighting,
             std::span<const ObjectAtInstant> objects, const PixelRect& cull_rect, double occluder_lod_px = 0);
+  // Draws the ground catcher's alpha (1 - ratio, as draw() gives it per pixel) over the world
+  // square (x, y min and max) into the bound framebuffer's viewport, x right and y up: the texel
+  // centre (i + 0.5, j + 0.5) / size holds the ground point there. Needs lighting.shadow.
+  void bake_ground_catcher(const Lighting& lighting, const UploadedObject& catcher, const std::array<float, 4>& square);
   // rg = end minus start image position (pixels of the lens image), b = depth at mid-exposure (m),
   // a = 1, with depth test at the mid-exposure position; for a float colour target.
   void draw_velocity(const LensUniforms& lens, const RowProjection& rows,
@@ -96,8 +106,15 @@ class ObjectRenderer {
   void set_frame_uniforms(const GlProgram& program, const LensUniforms& lens, const RowProjection& rows,
                           const Lighting& lighting) const;
   std::map<std::pair<ShadowMethod, bool>, GlProgram> shading_;  // one per shadow lookup
+  // The same fragment shader placed on the ground catcher's bake texture.
+  const GlProgram& baking(ShadowMethod method, bool real_shadow);
+  std::map<std::pair<ShadowMethod, bool>, GlProgram> baking_;
+  // The fragment-side uniforms: the light, the shadow lookups, the catcher's; binds the program.
+  void set_light_uniforms(const GlProgram& program, const Lighting& lighting) const;
+  void set_object_placement(const GlProgram& program, const UploadedObject& object) const;
   GlProgram velocity_;
   GlProgram occluder_;  // proxies that hide but catch no shadow: depth only
+  GlProgram baked_catcher_;  // the ground catcher from its bake
 };
 
 }  // namespace arpipe

@@ -52,6 +52,7 @@ RenderStage::~RenderStage() {
   warp_pass_.reset();
   shadow_pass_.reset();
   receiver_.reset();
+  catcher_bake_.reset();
   drawer_.reset();
 }
 
@@ -345,6 +346,13 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
     return Drawn::Reused;
   }
   session_->make_current();
+  if (request.lighting.shadow && settings_.shadows.bake_catcher) {
+    if (!catcher_bake_) catcher_bake_ = std::make_unique<CatcherBake>(session_->layer().color_format() == GL_RGBA16F);
+    const UploadedObject& catcher = *request.objects.back();
+    const double focal_px = std::max(canvas_camera.fx(), canvas_camera.fy());
+    request.lighting.baked_catcher = catcher_bake_->for_frame(
+        drawer_->objects(), request.lighting, catcher, catcher_texels_needed(catcher, exposure_poses, focal_px), shadow_redrawn);
+  }
   VirtualLayer& layer = session_->layer();
   const LayerDrawResult drawn = drawer_->draw(layer, request, settings_.blur);
   glDisable(GL_SCISSOR_TEST);

@@ -20,6 +20,7 @@
 #include "render/scene_physics.h"
 #include "render/occlusion_meter.h"
 #include "render/shadow/shadow_map.h"
+#include "render/shadow/catcher_bake.h"
 #include "render/shadow/shadow_receiver.h"
 #include "render/shadow/unshadowed_objects.h"
 
@@ -96,6 +97,7 @@ class RenderStage final : public Stage {
   std::unique_ptr<LensWarpPass> warp_pass_;  // made by configure with render.lens = "map"
   std::unique_ptr<ShadowMapPass> shadow_pass_;  // made by configure unless render.shadows.method = "off"
   std::unique_ptr<ShadowReceiver> receiver_;
+  std::unique_ptr<CatcherBake> catcher_bake_;  // made on the first frame with a shadow
   std::unique_ptr<ShadowMapPass> real_shadow_pass_;  // the casting proxies alone (made when there are any)
   Vec3 shadow_light_direction_{0, 0, 0};  // what the shadow map was made for (moves in steps)
   PerModelCache<LensWarpMap> warp_maps_;

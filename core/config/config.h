@@ -395,6 +395,10 @@ struct ShadowConfig {
   // tilted by t from up sees the sky over (1 + cos t) / 2 of its view and the lit ground over the
   // rest. An estimated light's SH already holds what the ground sends.
   double ground_albedo = 0.2;
+  // The ground catcher's ratio is a function of the ground point alone: while the light, the
+  // shadow maps and the casters stay the same, it is baked once into a texture over the catcher
+  // (render/shadow/catcher_bake.h) and each frame reads it back with one filtered lookup per pixel.
+  bool bake_catcher = true;
 
   bool operator==(const ShadowConfig&) const = default;
 };
@@ -416,6 +420,8 @@ void visit(V& v, ShadowConfig& s) {
   v.key("sky_occlusion", s.sky_occlusion, "the objects also hide ambient light from the real surfaces beside them (costs footprint)");
   v.key("ground_albedo", s.ground_albedo, NumberRange::closed(0, 1),
         "the real ground's: the light it bounces onto tilted real surfaces that catch shadows, under a constant ambient");
+  v.key("bake_catcher", s.bake_catcher,
+        "bake the ground's shadow into a texture while light and casters stay still (false: filter it per pixel every frame)");
 }
 
 // The precomputed radiance transfer bake (render/prt): run once per mesh and kept in a cache

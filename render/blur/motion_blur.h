@@ -53,6 +53,7 @@ class MotionBlurDrawer {
   // Compiles what a method needs now rather than on its first blurred frame.
   void prepare(BlurMethod method);
   void prepare_shadows(ShadowMethod method) { objects_.prepare(method); }
+  ObjectRenderer& objects() { return objects_; }  // for the ground catcher's bake
 
   LayerDrawResult draw(VirtualLayer& layer, const LayerDrawRequest& request, const BlurConfig& config);
 

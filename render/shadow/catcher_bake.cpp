@@ -1,0 +1,112 @@
+// The ground catcher's ratio baked into a texture (see catcher_bake.h).
+#include "render/shadow/catcher_bake.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+
+#include "core/log.h"
+#include "render/gl/gl_error.h"
+
+namespace arpipe {
+namespace {
+
+void push(std::vector<float>& key, const Vec3& v) {
+  for (double x : v) key.push_back(static_cast<float>(x));
+}
+
+void push(std::vector<float>& key, const ShadowLookup* lookup) {
+  if (!lookup) {
+    key.push_back(-1);
+    return;
+  }
+  key.push_back(static_cast<float>(lookup->method));
+  key.push_back(static_cast<float>(lookup->texture));
+  key.insert(key.end(), lookup->clip_from_world.begin(), lookup->clip_from_world.end());
+  key.insert(key.end(), lookup->depth_plane.begin(), lookup->depth_plane.end());
+  key.insert(key.end(), {lookup->local ? 1.0f : 0.0f, lookup->near_m, lookup->range_m, lookup->texel, lookup->bias,
+                         lookup->pcf_radius_texels, lookup->penumbra_texels_per_depth, lookup->max_search_texels,
+                         lookup->vsm_min_variance, lookup->vsm_bleed_reduction});
+}
+
+// The catcher's square (world x, y min and max): it stands unrotated (shadow_receiver.h).
+std::array<float, 4> square_of(const UploadedObject& catcher) {
+  const Vec3 centre = catcher.T_world_object.translation();
+  const double half = 0.5 * catcher.scale;
+  return {static_cast<float>(centre[0] - half), static_cast<float>(centre[1] - half),
+          static_cast<float>(centre[0] + half), static_cast<float>(centre[1] + half)};
+}
+
+}  // namespace
+
+double catcher_texels_needed(const UploadedObject& catcher, std::span<const SE3> T_cam_world, double focal_px) {
+  const Vec3 centre = catcher.T_world_object.translation();
+  const double half = 0.5 * catcher.scale;
+  double nearest = INFINITY;
+  for (const SE3& pose : T_cam_world) {
+    const Vec3 eye = pose.inverse().translation();
+    const double dx = std::max(std::abs(eye[0] - centre[0]) - half, 0.0);
+    const double dy = std::max(std::abs(eye[1] - centre[1]) - half, 0.0);
+    nearest = std::min(nearest, std::sqrt(dx * dx + dy * dy + (eye[2] - centre[2]) * (eye[2] - centre[2])));
+  }
+  return nearest > 0 ? kCatcherBakeTexelsPerPixel * catcher.scale * focal_px / nearest : INFINITY;
+}
+
+std::vector<float> CatcherBake::key_of(const Lighting& lighting, const UploadedObject& catcher) const {
+  std::vector<float> key;
+  key.reserve(160);
+  push(key, lighting.direction);
+  push(key, lighting.position);
+  key.push_back(lighting.local ? 1.0f : 0.0f);
+  push(key, lighting.color);
+  push(key, lighting.ambient);
+  push(key, lighting.ground_radiance);
+  for (const Vec3& c : lighting.ambient_sh) push(key, c);
+  for (const Vec3& c : lighting.radiance_sh) push(key, c);
+  for (const std::array<float, 4>& sphere : lighting.sky_occluders) key.insert(key.end(), sphere.begin(), sphere.end());
+  key.insert(key.end(), lighting.catcher_patch.begin(), lighting.catcher_patch.end());
+  push(key, lighting.shadow);
+  push(key, lighting.real_shadow);
+  const std::array<float, 4> square = square_of(catcher);
+  key.insert(key.end(), square.begin(), square.end());
+  push(key, catcher.T_world_object.translation());
+  key.push_back(static_cast<float>(shadow_generation_));
+  return key;
+}
+
+Lighting::BakedCatcher CatcherBake::for_frame(ObjectRenderer& renderer, const Lighting& lighting,
+                                              const UploadedObject& catcher, double texels_needed, bool shadow_redrawn) {
+  if (shadow_redrawn) ++shadow_generation_;
+  std::vector<float> key = key_of(lighting, catcher);
+  const bool changed = key != last_key_;
+  const bool churning = changed && changed_last_frame_;
+  changed_last_frame_ = changed;
+  last_key_ = key;
+  if (!float_target_ || !lighting.shadow || !(texels_needed <= kMaxCatcherBakeTexels)) return {};
+  if (key == baked_key_ && texels_needed <= size_) return {target_.texture(), square_of(catcher)};
+  if (churning) return {};
+
+  const int size = std::clamp(static_cast<int>(std::bit_ceil(static_cast<unsigned>(std::ceil(texels_needed)))),
+                              kMinCatcherBakeTexels, kMaxCatcherBakeTexels);
+  target_.ensure(GL_RGBA16F, size, size, false);
+  glBindTexture(GL_TEXTURE_2D, target_.texture());
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glBindTexture(GL_TEXTURE_2D, 0);
+  glDisable(GL_SCISSOR_TEST);
+  glBindFramebuffer(GL_FRAMEBUFFER, target_.framebuffer());
+  glViewport(0, 0, size, size);
+  renderer.bake_ground_catcher(lighting, catcher, square_of(catcher));
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  check_gl("baking the ground catcher");
+  size_ = size;
+  baked_key_ = std::move(key);
+  ++bakes_;
+  log::debug("render: ground catcher baked at {} x {} texels over {:.3f} m ({} texels needed; bake {})", size, size,
+             catcher.scale, texels_needed, bakes_);
+  return {target_.texture(), square_of(catcher)};
+}
+
+}  // namespace arpipe

@@ -1,0 +1,61 @@
+// The ground catcher's ratio baked into a texture over its square. The ratio the catcher draws
+// (object_renderer.h) depends on the ground point, the light, the shadow maps and the virtual
+// objects' sky occlusion, never on the camera: while those stay the same, one bake serves every
+// frame, the camera moving or not, and each frame's catcher costs one filtered lookup per pixel
+// instead of the shadow filter's taps (PCSS: 72 per pixel).
+//
+// When to bake: when the inputs changed since the last bake, unless they also changed on the
+// frame before (a light estimated anew each frame, a moving caster): then the catcher is drawn
+// per pixel, which costs less than a bake a frame. So a still light over a still scene bakes on
+// its first frame and never again. The texture holds at least two texels per canvas pixel at the
+// point of the square nearest the camera (baked again, larger, when the camera comes closer), at
+// most kMaxCatcherBakeTexels across (nearer than that, the catcher is drawn per pixel).
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "core/geometry/se3.h"
+#include "render/gl/texture_target.h"
+#include "render/object_renderer.h"
+
+namespace arpipe {
+
+inline constexpr int kMinCatcherBakeTexels = 64;
+// Texels per canvas pixel at the square's nearest point: 2 keeps the filtered lookup's blur of
+// the contact shadow at the objects' feet to half a pixel.
+inline constexpr double kCatcherBakeTexelsPerPixel = 2.0;
+inline constexpr int kMaxCatcherBakeTexels = 1024;
+
+// Texels across the catcher's square for kCatcherBakeTexelsPerPixel per canvas pixel at its nearest
+// point to any of the camera centres (T_cam_world poses): that times side * focal_px / distance;
+// infinite when a camera is on it.
+double catcher_texels_needed(const UploadedObject& catcher, std::span<const SE3> T_cam_world, double focal_px);
+
+class CatcherBake {
+ public:
+  // float_target: the GL can draw into half floats (the ratio is kept to 1/2048); without, it never bakes.
+  explicit CatcherBake(bool float_target) : float_target_(float_target) {}
+
+  // This frame's bake of the ground catcher (the last entry drawn under lighting.shadow), baked
+  // now if it must be; texture 0: draw it per pixel. shadow_redrawn: a shadow map was drawn anew
+  // this frame (its content changed). Leaves framebuffer 0 bound and the scissor test off.
+  Lighting::BakedCatcher for_frame(ObjectRenderer& renderer, const Lighting& lighting, const UploadedObject& catcher,
+                                   double texels_needed, bool shadow_redrawn);
+  uint64_t bakes() const { return bakes_; }  // how many times it baked
+
+ private:
+  std::vector<float> key_of(const Lighting& lighting, const UploadedObject& catcher) const;
+
+  bool float_target_;
+  TextureTarget target_;
+  int size_ = 0;                       // texels across the baked texture; 0: none yet
+  std::vector<float> baked_key_;       // what the texture was baked from
+  std::vector<float> last_key_;        // the last frame's inputs
+  bool changed_last_frame_ = false;
+  uint64_t shadow_generation_ = 0;     // counts redrawn shadow maps: part of the key
+  uint64_t bakes_ = 0;
+};
+
+}  // namespace arpipe
