@@ -19,10 +19,13 @@ double largest_light_value(const Lighting& l) {
   };
   take(l.color);
   take(l.ambient);
+  take(l.ground_radiance);
   for (const Vec3& c : l.ambient_sh) take(c);
   for (const Vec3& c : l.radiance_sh) take(c);
   return largest;
 }
+
+}  // namespace
 
 bool same_light(const Lighting& a, const Lighting& b) {
   if (a.local != b.local || a.shadow != b.shadow) return false;
@@ -33,11 +36,16 @@ bool same_light(const Lighting& a, const Lighting& b) {
       if (std::abs(x[i] - y[i]) > tolerance) return false;
     return true;
   };
-  if (!close(a.color, b.color) || !close(a.ambient, b.ambient)) return false;
+  if (!close(a.color, b.color) || !close(a.ambient, b.ambient) || !close(a.ground_radiance, b.ground_radiance)) return false;
   for (size_t i = 0; i < a.ambient_sh.size(); ++i)
     if (!close(a.ambient_sh[i], b.ambient_sh[i]) || !close(a.radiance_sh[i], b.radiance_sh[i])) return false;
   // A lamp's place: the same turn as the direction, seen from a metre.
-  if (a.local && norm(a.position - b.position) > LayerReuse::kMaxLightTurnRad) return false;
+  return !(a.local && norm(a.position - b.position) > LayerReuse::kMaxLightTurnRad);
+}
+
+namespace {
+
+bool same_exposure(const Lighting& a, const Lighting& b) {
   const double scale = std::max(std::abs(a.exposure_scale), std::abs(b.exposure_scale));
   return std::abs(a.exposure_scale - b.exposure_scale) <= LayerReuse::kMaxLightChange * scale;
 }
@@ -75,7 +83,7 @@ bool LayerReuse::can_reuse(const Inputs& now) const {
     if (max_corner_motion_px(*now.camera_model, now.objects, last_.exposure_poses[k], now.exposure_poses[k]) >
         kMaxMotionPx)
       return false;
-  return same_light(now.lighting, last_.lighting);
+  return same_light(now.lighting, last_.lighting) && same_exposure(now.lighting, last_.lighting);
 }
 
 void LayerReuse::remember(Inputs inputs, const VirtualLayerTexture& layer, std::string blur_method, int blur_samples) {

@@ -25,6 +25,11 @@
 
 namespace arpipe {
 
+// Whether two frames' lights draw the same picture, exposure aside: the same kind and shadow map,
+// turned less than LayerReuse::kMaxLightTurnRad (a lamp moved less than that many metres), and
+// no value (direct, ambient, the ground's, SH) apart by more than kMaxLightChange of the largest.
+bool same_light(const Lighting& a, const Lighting& b);
+
 class LayerReuse {
  public:
   // Well under a pixel, and above the tracker's own frame-to-frame noise on a still camera (0.09 to

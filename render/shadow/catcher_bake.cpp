@@ -7,6 +7,7 @@
 
 #include "core/log.h"
 #include "render/gl/gl_error.h"
+#include "render/layer_reuse.h"
 
 namespace arpipe {
 namespace {
@@ -52,38 +53,37 @@ double catcher_texels_needed(const UploadedObject& catcher, std::span<const SE3>
   return nearest > 0 ? kCatcherBakeTexelsPerPixel * catcher.scale * focal_px / nearest : INFINITY;
 }
 
-std::vector<float> CatcherBake::key_of(const Lighting& lighting, const UploadedObject& catcher) const {
-  std::vector<float> key;
-  key.reserve(160);
-  push(key, lighting.direction);
-  push(key, lighting.position);
-  key.push_back(lighting.local ? 1.0f : 0.0f);
-  push(key, lighting.color);
-  push(key, lighting.ambient);
-  push(key, lighting.ground_radiance);
-  for (const Vec3& c : lighting.ambient_sh) push(key, c);
-  for (const Vec3& c : lighting.radiance_sh) push(key, c);
-  for (const std::array<float, 4>& sphere : lighting.sky_occluders) key.insert(key.end(), sphere.begin(), sphere.end());
-  key.insert(key.end(), lighting.catcher_patch.begin(), lighting.catcher_patch.end());
-  push(key, lighting.shadow);
-  push(key, lighting.real_shadow);
+CatcherBake::Key CatcherBake::key_of(const Lighting& lighting, const UploadedObject& catcher) const {
+  Key key;
+  key.valid = true;
+  key.light = lighting;
+  std::vector<float>& exact = key.exact;
+  exact.reserve(80);
+  for (const std::array<float, 4>& sphere : lighting.sky_occluders) exact.insert(exact.end(), sphere.begin(), sphere.end());
+  exact.insert(exact.end(), lighting.catcher_patch.begin(), lighting.catcher_patch.end());
+  push(exact, lighting.shadow);
+  push(exact, lighting.real_shadow);
   const std::array<float, 4> square = square_of(catcher);
-  key.insert(key.end(), square.begin(), square.end());
-  push(key, catcher.T_world_object.translation());
-  key.push_back(static_cast<float>(shadow_generation_));
+  exact.insert(exact.end(), square.begin(), square.end());
+  push(exact, catcher.T_world_object.translation());
+  exact.push_back(static_cast<float>(shadow_generation_));
   return key;
+}
+
+bool CatcherBake::Key::matches(const Key& other) const {
+  return valid && other.valid && exact == other.exact && same_light(light, other.light);
 }
 
 Lighting::BakedCatcher CatcherBake::for_frame(ObjectRenderer& renderer, const Lighting& lighting,
                                               const UploadedObject& catcher, double texels_needed, bool shadow_redrawn) {
   if (shadow_redrawn) ++shadow_generation_;
-  std::vector<float> key = key_of(lighting, catcher);
-  const bool changed = key != last_key_;
+  Key key = key_of(lighting, catcher);
+  const bool changed = !key.matches(last_key_);
   const bool churning = changed && changed_last_frame_;
   changed_last_frame_ = changed;
   last_key_ = key;
   if (!float_target_ || !lighting.shadow || !(texels_needed <= kMaxCatcherBakeTexels)) return {};
-  if (key == baked_key_ && texels_needed <= size_) return {target_.texture(), square_of(catcher)};
+  if (key.matches(baked_key_) && texels_needed <= size_) return {target_.texture(), square_of(catcher)};
   if (churning) return {};
 
   const int size = std::clamp(static_cast<int>(std::bit_ceil(static_cast<unsigned>(std::ceil(texels_needed)))),

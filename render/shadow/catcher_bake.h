@@ -4,8 +4,8 @@
 // frame, the camera moving or not, and each frame's catcher costs one filtered lookup per pixel
 // instead of the shadow filter's taps (PCSS: 72 per pixel).
 //
-// When to bake: when the inputs changed since the last bake, unless they also changed on the
-// frame before (a light estimated anew each frame, a moving caster): then the catcher is drawn
+// When to bake: when the inputs changed since the last bake (the light by more than the layer
+// reuse's tolerances, render/layer_reuse.h), unless they also changed on the frame before (a light estimated anew each frame, a moving caster): then the catcher is drawn
 // per pixel, which costs less than a bake a frame. So a still light over a still scene bakes on
 // its first frame and never again. The texture holds at least two texels per canvas pixel at the
 // point of the square nearest the camera (baked again, larger, when the camera comes closer), at
@@ -46,13 +46,22 @@ class CatcherBake {
   uint64_t bakes() const { return bakes_; }  // how many times it baked
 
  private:
-  std::vector<float> key_of(const Lighting& lighting, const UploadedObject& catcher) const;
+  // What the bake depends on: the light, compared within the layer reuse's tolerances (same_light:
+  // a quarter of 1/255 at most), and the rest exactly: the shadow maps, the sky's occluders, the
+  // catcher's square.
+  struct Key {
+    bool valid = false;
+    Lighting light;
+    std::vector<float> exact;
+    bool matches(const Key& other) const;
+  };
+  Key key_of(const Lighting& lighting, const UploadedObject& catcher) const;
 
   bool float_target_;
   TextureTarget target_;
   int size_ = 0;                       // texels across the baked texture; 0: none yet
-  std::vector<float> baked_key_;       // what the texture was baked from
-  std::vector<float> last_key_;        // the last frame's inputs
+  Key baked_key_;                      // what the texture was baked from
+  Key last_key_;                       // the last frame's inputs
   bool changed_last_frame_ = false;
   uint64_t shadow_generation_ = 0;     // counts redrawn shadow maps: part of the key
   uint64_t bakes_ = 0;
