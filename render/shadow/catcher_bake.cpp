@@ -38,7 +38,37 @@ std::array<float, 4> square_of(const UploadedObject& catcher) {
           static_cast<float>(centre[0] + half), static_cast<float>(centre[1] + half)};
 }
 
+// Luminance weights (Rec. 709), as the catcher's shader takes them.
+double luminance(const Vec3& rgb) { return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]; }
+
+// The ground catcher's ambient luminance: its normal is up, where the sky-above-the-ground model
+// gives the whole constant ambient, and the SH's terms are those of Y_0, Y_1,0 and Y_2,0 (the
+// shader's constants).
+double ground_ambient_luminance(const Lighting& l) {
+  return luminance(l.ambient) + 0.282095 * luminance(l.ambient_sh[0]) + 0.488603 * luminance(l.ambient_sh[2]) +
+         0.315392 * 2.0 * luminance(l.ambient_sh[6]);
+}
+
 }  // namespace
+
+bool same_catcher_light(const Lighting& a, const Lighting& b) {
+  if (a.local != b.local || a.shadow != b.shadow || a.real_shadow != b.real_shadow) return false;
+  if (std::acos(std::clamp(dot(a.direction, b.direction), -1.0, 1.0)) > LayerReuse::kMaxLightTurnRad) return false;
+  if (a.local && norm(a.position - b.position) > LayerReuse::kMaxLightTurnRad) return false;
+  const double direct_a = luminance(a.color), direct_b = luminance(b.color);
+  const double ambient_a = ground_ambient_luminance(a), ambient_b = ground_ambient_luminance(b);
+  const double tolerance = kCatcherBakeLightChange * std::max({std::abs(direct_a), std::abs(direct_b), std::abs(ambient_a),
+                                                               std::abs(ambient_b)});
+  if (std::abs(direct_a - direct_b) > tolerance || std::abs(ambient_a - ambient_b) > tolerance) return false;
+  if (a.sky_occluders.empty() && b.sky_occluders.empty()) return true;
+  // The sky occlusion weighs the ambient radiance by direction.
+  double largest = 0;
+  for (size_t i = 0; i < a.radiance_sh.size(); ++i)
+    largest = std::max({largest, std::abs(luminance(a.radiance_sh[i])), std::abs(luminance(b.radiance_sh[i]))});
+  for (size_t i = 0; i < a.radiance_sh.size(); ++i)
+    if (std::abs(luminance(a.radiance_sh[i]) - luminance(b.radiance_sh[i])) > kCatcherBakeLightChange * largest) return false;
+  return true;
+}
 
 double catcher_texels_needed(const UploadedObject& catcher, std::span<const SE3> T_cam_world, double focal_px) {
   const Vec3 centre = catcher.T_world_object.translation();
@@ -71,7 +101,7 @@ CatcherBake::Key CatcherBake::key_of(const Lighting& lighting, const UploadedObj
 }
 
 bool CatcherBake::Key::matches(const Key& other) const {
-  return valid && other.valid && exact == other.exact && same_light(light, other.light);
+  return valid && other.valid && exact == other.exact && same_catcher_light(light, other.light);
 }
 
 Lighting::BakedCatcher CatcherBake::for_frame(ObjectRenderer& renderer, const Lighting& lighting,

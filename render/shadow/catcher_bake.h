@@ -4,8 +4,8 @@
 // frame, the camera moving or not, and each frame's catcher costs one filtered lookup per pixel
 // instead of the shadow filter's taps (PCSS: 72 per pixel).
 //
-// When to bake: when the inputs changed since the last bake (the light by more than the layer
-// reuse's tolerances, render/layer_reuse.h), unless they also changed on the frame before (a light estimated anew each frame, a moving caster): then the catcher is drawn
+// When to bake: when the inputs changed since the last bake (the light by more than
+// same_catcher_light allows), unless they also changed on the frame before (a light estimated anew each frame, a moving caster): then the catcher is drawn
 // per pixel, which costs less than a bake a frame. So a still light over a still scene bakes on
 // its first frame and never again. The texture holds at least two texels per canvas pixel at the
 // point of the square nearest the camera (baked again, larger, when the camera comes closer), at
@@ -28,6 +28,17 @@ inline constexpr int kMinCatcherBakeTexels = 64;
 inline constexpr double kCatcherBakeTexelsPerPixel = 2.0;
 inline constexpr int kMaxCatcherBakeTexels = 1024;
 
+// Whether two lights give the ground catcher the same ratio within 1/1000 (a quarter of 1/255).
+// The ratio (A + V D) / (A + D) depends on the light through the luminance of the direct light D,
+// of the ambient light at the ground's normal A and, with sky occlusion, of the ambient radiance's
+// SH; moving A and D by dA and dD moves it by at most (D |dA| + A |dD|) / (A + D)^2, which is at
+// most e when each moves by at most e times the larger of the two. So each may move by
+// kCatcherBakeLightChange of the larger (the SH by that share of its largest coefficient), the
+// direction and a lamp's place by the layer reuse's 1e-4 (render/layer_reuse.h); the shadow maps
+// must be the same.
+inline constexpr double kCatcherBakeLightChange = 1e-3;
+bool same_catcher_light(const Lighting& a, const Lighting& b);
+
 // Texels across the catcher's square for kCatcherBakeTexelsPerPixel per canvas pixel at its nearest
 // point to any of the camera centres (T_cam_world poses): that times side * focal_px / distance;
 // infinite when a camera is on it.
@@ -46,9 +57,8 @@ class CatcherBake {
   uint64_t bakes() const { return bakes_; }  // how many times it baked
 
  private:
-  // What the bake depends on: the light, compared within the layer reuse's tolerances (same_light:
-  // a quarter of 1/255 at most), and the rest exactly: the shadow maps, the sky's occluders, the
-  // catcher's square.
+  // What the bake depends on: the light, compared as the catcher sees it (same_catcher_light), and
+  // the rest exactly: the shadow maps, the sky's occluders, the catcher's square.
   struct Key {
     bool valid = false;
     Lighting light;
