@@ -30,10 +30,24 @@ void clear_written_outside(GLuint framebuffer, PixelRect& written, const PixelRe
   if (!written.empty() && !(written == keep)) {
     glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
     glEnable(GL_SCISSOR_TEST);
-    glScissor(written.x, written.y, written.width, written.height);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     const GLfloat transparent[4] = {0, 0, 0, 0};
-    glClearBufferfv(GL_COLOR, 0, transparent);
+    const auto clear = [&](int x0, int y0, int x1, int y1) {
+      if (x1 <= x0 || y1 <= y0) return;
+      glScissor(x0, y0, x1 - x0, y1 - y0);
+      glClearBufferfv(GL_COLOR, 0, transparent);
+    };
+    // Only what lies outside keep: a software rasteriser's clear costs per pixel, and from one
+    // frame to the next the rectangle moves by a few pixels.
+    const PixelRect both = written.intersected(keep);
+    if (both.empty()) {
+      clear(written.x, written.y, written.right(), written.bottom());
+    } else {
+      clear(written.x, written.y, written.right(), both.y);                 // the rows above
+      clear(written.x, both.bottom(), written.right(), written.bottom());   // the rows below
+      clear(written.x, both.y, both.x, both.bottom());                      // left, beside keep
+      clear(both.right(), both.y, written.right(), both.bottom());          // right, beside keep
+    }
   }
   written = keep;
 }

@@ -10,9 +10,8 @@
 namespace arpipe {
 
 // Keeps a texture transparent outside the rectangle last drawn (warped and gathered samples read
-// beyond it): clears `written`, what `framebuffer`'s colour attachment may hold, to transparent
-// unless it is `keep`, then records `keep` as written. The old rectangle and the new one usually
-// overlap; clearing the old one whole is simpler than their difference and costs about the same.
+// beyond it): clears what of `written` (what `framebuffer`'s colour attachment may hold) lies
+// outside `keep`, which the caller is about to cover, then records `keep` as written.
 void clear_written_outside(GLuint framebuffer, PixelRect& written, const PixelRect& keep);
 
 class TextureTarget {
