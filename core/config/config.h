@@ -801,6 +801,12 @@ struct PipelineConfig {
   int sink_queue_depth = 4;
   int64_t max_frames = 0;  // 0 = no limit
   log::Level log_level = log::Level::Info;
+  // The first stage (tracking) of a frame runs on a helper thread while the later stages finish
+  // the frame before, when the next frame is already waiting (a replay, a camera the pipeline
+  // lags behind); each stage still sees every frame in order, so a replay stays the same frame for
+  // frame. Off by default: on two cores the tracker and llvmpipe's threads slow each other down
+  // more than the overlap gains (BENCHMARKS.md "Pipeline throughput"); try it on a larger board.
+  bool overlap_first_stage = false;
 
   bool operator==(const PipelineConfig&) const = default;
 };
@@ -814,6 +820,8 @@ void visit(V& v, PipelineConfig& s) {
         "frames waiting for each sink; beyond it a live camera's slow sink drops its oldest (a replay waits)");
   v.key("max_frames", s.max_frames, IntRange{0}, "stop after this many frames; 0 = no limit");
   v.key("log_level", s.log_level, kLogLevelNames, "what the daemon logs");
+  v.key("overlap_first_stage", s.overlap_first_stage,
+        "track the next waiting frame on a helper thread while the last one renders");
 }
 
 // The daemon's control socket (arpipe ctl: status, reload, set, snapshot, record).

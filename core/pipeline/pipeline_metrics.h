@@ -25,6 +25,9 @@ struct PipelineMetrics {
   uint64_t frames_tracked = 0;
   uint64_t frames_predicted = 0;  // no detection, pose extrapolated (TrackState::Predicted)
   uint64_t frames_lost = 0;
+  // Frames whose first stage ran on the helper thread beside the previous frame's later stages
+  // (pipeline.overlap_first_stage).
+  uint64_t frames_overlapped = 0;
   std::map<std::string, StageStats> stages;
   // From the end of exposure (FrameContext::latency_origin_ns) to the frame's hand-over to the sinks.
   LatencyHistogram latency_seconds;

@@ -176,24 +176,62 @@ void PipelineRunner::processing_loop() {
   const auto finish_held = [&](size_t keep) {
     for (; held.size() > keep; held.pop_front()) finish_frame(held.front().first, held.front().second);
   };
+  // A frame's stages from `first` on: those before the one with latency, then held or finished.
+  const auto run_from = [&](FrameContext& ctx, size_t first) {
+    const size_t split = first_stage_with_latency();
+    for (size_t i = first; i < split; ++i) stages_[i]->process(ctx);
+    if (split < stages_.size()) {
+      stages_[split]->look_ahead(ctx);
+      held.emplace_back(std::move(ctx), split);
+      finish_held(size_t(stages_[split]->latency_frames()));
+    } else {
+      finish_held(0);  // held under a config that has since dropped the latency
+      finish_frame(ctx, split);
+    }
+  };
+  // Whether the first stage may run on its own, ahead of the others (see below).
+  const auto first_runs_ahead = [&] {
+    return config_.pipeline.overlap_first_stage && !stages_.empty() && stages_[0]->can_run_ahead() &&
+           first_stage_with_latency() > 0;
+  };
+  // A frame whose first stage has run and whose later stages wait for the next frame: when the
+  // next one is already queued (a replay, a camera the pipeline lags behind), its first stage
+  // (tracking) runs on a helper thread while this thread runs the later stages (rendering) of this
+  // one. Each stage still sees the frames in order. A frame with nothing queued behind it goes on
+  // at once, so a live camera's frames wait for no later frame.
+  std::optional<FrameContext> waiting;
   while (auto ctx = to_process_->pop()) {
     busy_since_ns_ = monotonic_now_ns();
     // Frames the live queue dropped are lost just like a sequence gap, so the next frame says so.
     ctx->dropped_before += ctx->input_index - expected_index;
     expected_index = ctx->input_index + 1;
-    apply_pending_reconfigure();
-    const size_t split = first_stage_with_latency();
-    for (size_t i = 0; i < split; ++i) stages_[i]->process(*ctx);
-    if (split < stages_.size()) {
-      stages_[split]->look_ahead(*ctx);
-      held.emplace_back(std::move(*ctx), split);
-      finish_held(size_t(stages_[split]->latency_frames()));
+    if (std::shared_ptr<StageReloader::Request> request = reloader_->claim()) {
+      // The waiting frame finishes under the config its first stage ran with.
+      if (waiting) run_from(*waiting, 1);
+      waiting.reset();
+      apply_reconfigure(request);
+    }
+    if (waiting) {
+      FrameContext& next = *ctx;
+      std::future<void> first = std::async(std::launch::async, [&] { stages_[0]->process(next); });
+      run_from(*waiting, 1);
+      first.wait();
+      waiting.reset();
+      {
+        std::lock_guard lock(metrics_mutex_);
+        ++metrics_.frames_overlapped;
+      }
+      if (to_process_->size() > 0) waiting = std::move(*ctx);
+      else run_from(*ctx, 1);
+    } else if (first_runs_ahead() && to_process_->size() > 0) {
+      stages_[0]->process(*ctx);
+      waiting = std::move(*ctx);
     } else {
-      finish_held(0);  // held under a config that has since dropped the latency
-      finish_frame(*ctx, split);
+      run_from(*ctx, 0);
     }
     busy_since_ns_ = 0;
   }
+  if (waiting) run_from(*waiting, 1);
   finish_held(0);  // the end of the stream: the last frames go on without a look-ahead
   to_sink_->close();
   reloader_->close("the stream has ended; nothing left to reconfigure");
@@ -272,9 +310,7 @@ bool PipelineRunner::reconfigure(const Config& config, std::string& error,
   return reloader_->reconfigure(reloader_->new_ticket(), config, error, boundary_timeout);
 }
 
-void PipelineRunner::apply_pending_reconfigure() {
-  const std::shared_ptr<StageReloader::Request> request = reloader_->claim();
-  if (!request) return;
+void PipelineRunner::apply_reconfigure(const std::shared_ptr<StageReloader::Request>& request) {
   const StageReloader::Loaded& next = reloader_->loaded(*request);
   std::string error;
   for (size_t i = 0; i < stages_.size(); ++i) {

@@ -114,8 +114,8 @@ class PipelineRunner {
   std::atomic<int64_t> busy_since_ns_{0};       // 0 while the processing thread waits for a frame
   std::atomic<int64_t> sink_busy_since_ns_{0};  // 0 while the sink thread waits for a frame
 
-  // Between frames, on the processing thread: swaps in a loaded reload, if one waits.
-  void apply_pending_reconfigure();
+  // Between frames, on the processing thread: swaps in the loaded reload it claimed.
+  void apply_reconfigure(const std::shared_ptr<StageReloader::Request>& request);
   std::shared_ptr<StageReloader> reloader_;  // made by start() with the stages' loaders
   int64_t start_ns_ = 0;
 

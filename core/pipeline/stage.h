@@ -49,6 +49,10 @@ class Stage {
   // each frame back after the stages before this one and shows the stage each arriving frame
   // through look_ahead() first; at the end of the stream the held frames go on without.
   virtual int latency_frames() const noexcept { return 0; }
+  // Whether process() reads and writes only the frame it is given and the stage's own state, so
+  // that as the first stage it may process frame n + 1 on another thread while the later stages
+  // process frame n (pipeline.overlap_first_stage).
+  virtual bool can_run_ahead() const noexcept { return false; }
   virtual void look_ahead(const FrameContext& next) noexcept { (void)next; }
 };
 

@@ -16,6 +16,8 @@ class TagTracker : public Stage {
   void configure(const Config& config) override;
   // Fills ctx.pose from ctx.camera and ctx.camera_model. Lost tracking is a state, never an error.
   void process(FrameContext& ctx) noexcept override;
+  // It needs only the frame, the camera model it carries and its own pose history.
+  bool can_run_ahead() const noexcept override { return true; }
 
  private:
   struct Impl;

@@ -15,62 +15,15 @@
 #include <unistd.h>
 #include <vector>
 
-#include "apps/common/pipeline_assembly.h"
-#include "core/config/config.h"
-#include "core/pipeline/frame_sink.h"
-#include "core/pipeline/pipeline_runner.h"
 #include "capture/recording/recording_reader.h"
 #include "capture/recording/recording_writer.h"
+#include "kept_frames.h"
 
 namespace fs = std::filesystem;
 namespace arpipe {
 namespace {
 
-const fs::path kConfigs = fs::path(ARPIPE_SOURCE_DIR) / "configs";
-const fs::path kBuild = fs::path(ARPIPE_BINARY_DIR);
-
-// What one composited frame showed, and what the render stage said of it.
-struct Shown {
-  uint64_t index = 0;
-  Frame output;
-  bool drawn = false;
-  VirtualLayerTexture layer;
-  int blur_samples = 0;
-  std::string render_skip;
-};
-
-class KeepFrames final : public FrameSink {
- public:
-  explicit KeepFrames(std::vector<Shown>& frames) : frames_(frames) {}
-  std::string describe() const override { return "test:keep"; }
-  void consume(const FrameContext& ctx) noexcept override {
-    Shown shown{ctx.input_index, ctx.output, ctx.virtual_layer_drawn, ctx.virtual_layer, ctx.blur_samples, {}};
-    for (const StageTiming& timing : ctx.timings)
-      if (timing.stage == "render") shown.render_skip = timing.skipped;
-    frames_.push_back(std::move(shown));
-  }
-
- private:
-  std::vector<Shown>& frames_;
-};
-
-std::vector<Shown> run(const fs::path& config_file, const fs::path& capture, int frames,
-                       std::vector<std::string> overrides) {
-  for (const std::string& o :
-       {std::string("source.path=\"") + capture.string() + "\"", std::string("source.pacing=\"fast\""),
-        std::string("sinks.png.enabled=false"), std::string("sinks.y4m.enabled=false"),
-        std::string("sinks.results.enabled=false"), std::string("pipeline.log_level=\"warning\""),
-        "pipeline.max_frames=" + std::to_string(frames)})
-    overrides.push_back(o);
-  const Config config = load_config(config_file, overrides);
-  std::vector<Shown> shown;
-  std::vector<std::unique_ptr<FrameSink>> sinks;
-  sinks.push_back(std::make_unique<KeepFrames>(shown));
-  PipelineRunner runner(make_source(config), make_stage_factory(), std::move(sinks), config);
-  runner.start();
-  runner.wait();
-  return shown;
-}
+using namespace kept_frames;
 
 // The largest difference of any byte between two runs' frames, which must show the same frames.
 int largest_difference(const std::vector<Shown>& a, const std::vector<Shown>& b) {

@@ -90,7 +90,7 @@ TEST(Config, DefaultTomlReadsBackAsTheDefaultConfigAndListsEveryKey) {
         "min_decision_margin = ", "ambiguity_ratio = ", "max_predicted_frames = ", "[[track.bundle]]", "id = ", "size_m = ", "center_m = ",
         "yaw_deg = ", "[motion]", "latency_frames = ", "default_exposure_ms = ", "[render]", "light_direction = ", "light_color = ", "ambient = ", "msaa_samples = ",
         "egl_platform = ", "lens = ", "lens_canvas_scale = ", "rolling_shutter = ", "max_predicted_uncertainty_deg = ", "reuse_layer = ", "full_canvas = ", "occluder_lod_px = ", "ground_albedo = ", "bake_catcher = ", "[render.blur]", "method = ", "samples = ",
-        "min_motion_px = ", "[pipeline]", "queue_depth = ", "max_frames = ", "log_level = "})
+        "min_motion_px = ", "[pipeline]", "queue_depth = ", "max_frames = ", "log_level = ", "overlap_first_stage = "})
     EXPECT_NE(text.find(std::string("\n") + line), std::string::npos) << line;
   // Absent by default (no objects, no sinks), so shown commented out with the values they take
   // when the config has them: reading the text back still gives the defaults (above).
