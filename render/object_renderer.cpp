@@ -305,29 +305,30 @@ std::string shading_program_name(std::string_view what, ShadowMethod method, boo
   return fmt::format("{} ({} shadows{})", what, shadow_method_name(method), real_shadow ? ", real casters" : "");
 }
 
-}  // namespace
-
-const GlProgram& ObjectRenderer::shading(ShadowMethod method, bool real_shadow) {
+// The program of `programs` for this lookup, compiled on first use with the shading fragment shader
+// and the vertex shader `vertex` makes.
+const GlProgram& program_for_lookup(std::map<std::pair<ShadowMethod, bool>, GlProgram>& programs, std::string_view what,
+                                    const std::function<std::string()>& vertex, ShadowMethod method, bool real_shadow) {
   const std::pair<ShadowMethod, bool> key{method, real_shadow};
-  auto found = shading_.find(key);
-  if (found == shading_.end())
-    found = shading_
-                .emplace(key, GlProgram(shading_program_name("object shading", method, real_shadow),
-                                        vertex_source({"pose"}, kShadingVertexShader),
+  auto found = programs.find(key);
+  if (found == programs.end())
+    found = programs
+                .emplace(key, GlProgram(shading_program_name(what, method, real_shadow), vertex(),
                                         shading_fragment_source(method, real_shadow)))
                 .first;
   return found->second;
 }
 
+}  // namespace
+
+const GlProgram& ObjectRenderer::shading(ShadowMethod method, bool real_shadow) {
+  return program_for_lookup(
+      shading_, "object shading", [] { return vertex_source({"pose"}, kShadingVertexShader); }, method, real_shadow);
+}
+
 const GlProgram& ObjectRenderer::baking(ShadowMethod method, bool real_shadow) {
-  const std::pair<ShadowMethod, bool> key{method, real_shadow};
-  auto found = baking_.find(key);
-  if (found == baking_.end())
-    found = baking_
-                .emplace(key, GlProgram(shading_program_name("ground catcher bake", method, real_shadow),
-                                        kCatcherBakeVertexShader, shading_fragment_source(method, real_shadow)))
-                .first;
-  return found->second;
+  return program_for_lookup(
+      baking_, "ground catcher bake", [] { return std::string(kCatcherBakeVertexShader); }, method, real_shadow);
 }
 
 namespace {
