@@ -439,18 +439,34 @@ void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, c
     set_lens_uniforms(occluder_, lens);
     set_row_projection(occluder_, rows);
   }
-  // The programs this draw uses, each given the frame's uniforms on first use.
-  const GlProgram* with_lookups = nullptr;
-  const GlProgram* without_lookups = nullptr;
-  const auto program_for = [&](const UploadedObject& object) -> const GlProgram& {
+  // The programs this draw uses, each given the frame's uniforms and its per-object uniforms'
+  // locations on first use.
+  struct InUse {
+    const GlProgram* program = nullptr;
+    GLint rotation = -1, translation = -1, scale = -1, shadow_catcher = -1, ground_catcher = -1, specular = -1,
+          camera_world = -1, prt = -1, prt_light = -1, base_color = -1;
+  };
+  InUse with_lookups, without_lookups;
+  const auto program_for = [&](const UploadedObject& object) -> const InUse& {
     const bool plain = method == ShadowMethod::Off || unshadowed(object);
-    const GlProgram*& program = plain ? without_lookups : with_lookups;
-    if (!program) {
-      program = plain ? &shading(ShadowMethod::Off, false) : &shading(method, real);
-      set_frame_uniforms(*program, lens, rows, lighting);
+    InUse& in_use = plain ? without_lookups : with_lookups;
+    if (!in_use.program) {
+      const GlProgram& program = plain ? shading(ShadowMethod::Off, false) : shading(method, real);
+      set_frame_uniforms(program, lens, rows, lighting);
+      in_use = {&program,
+                program.uniform("u_world_from_object_rotation"),
+                program.uniform("u_world_from_object_translation"),
+                program.uniform("u_object_scale"),
+                program.uniform("u_shadow_catcher"),
+                glGetUniformLocation(program.id(), "u_ground_catcher"),
+                program.uniform("u_specular"),
+                program.uniform("u_camera_world"),
+                program.uniform("u_prt"),
+                program.uniform("u_prt_light"),
+                program.uniform("u_base_color")};
     }
-    glUseProgram(program->id());
-    return *program;
+    glUseProgram(in_use.program->id());
+    return in_use;
   };
   const auto baked_ground_catcher = [&](const UploadedObject& object) {
     return object.shadow_catcher && !object.proxy && lighting.shadow && lighting.baked_catcher.texture != 0;
@@ -484,28 +500,31 @@ void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, c
       else draw_mesh(item, lens, cull_rect, [](const MeshPart&) {});
       continue;
     }
-    const GlProgram& program = program_for(*item.object);
-    set_row_poses(program, "pose", item.poses, item.object->scale);
-    set_object_placement(program, *item.object);
-    glUniform1i(program.uniform("u_shadow_catcher"), item.object->shadow_catcher ? 1 : 0);
-    const GLint ground_catcher = glGetUniformLocation(program.id(), "u_ground_catcher");
-    if (ground_catcher >= 0) glUniform1i(ground_catcher, item.object->shadow_catcher && !item.object->proxy ? 1 : 0);
+    const InUse& in_use = program_for(*item.object);
+    set_row_poses(*in_use.program, "pose", item.poses, item.object->scale);
+    const std::array<float, 9> rotation = column_major(item.object->T_world_object.rotation());
+    glUniformMatrix3fv(in_use.rotation, 1, GL_FALSE, rotation.data());
+    set_vec3(in_use.translation, item.object->T_world_object.translation());
+    glUniform1f(in_use.scale, static_cast<float>(item.object->scale));
+    glUniform1i(in_use.shadow_catcher, item.object->shadow_catcher ? 1 : 0);
+    if (in_use.ground_catcher >= 0)
+      glUniform1i(in_use.ground_catcher, item.object->shadow_catcher && !item.object->proxy ? 1 : 0);
     glDepthMask(item.object->writes_depth ? GL_TRUE : GL_FALSE);
-    glUniform1f(program.uniform("u_specular"),
+    glUniform1f(in_use.specular,
                 item.object->shadow_catcher || item.object->proxy ? 0.0f : static_cast<float>(item.object->specular));
     if (item.object->specular > 0 && !item.poses.T_cam_object.empty()) {
       // The eye of the middle row: rows differ by far less than the reflection's blur.
       const SE3& T_cam_object = item.poses.T_cam_object[item.poses.T_cam_object.size() / 2];
-      set_vec3(program.uniform("u_camera_world"), item.object->T_world_object * T_cam_object.inverse().translation());
+      set_vec3(in_use.camera_world, item.object->T_world_object * T_cam_object.inverse().translation());
     }
     const bool use_prt = item.object->mesh->has_transfer() && !item.object->shadow_catcher && !item.object->proxy;
-    glUniform1i(program.uniform("u_prt"), use_prt ? 1 : 0);
+    glUniform1i(in_use.prt, use_prt ? 1 : 0);
     if (use_prt) {
       // The transfer lives in the object's frame: turn the world's light into it.
       const std::array<float, 27> light = object_frame_light(lighting.radiance_sh, item.object->T_world_object.rotation());
-      glUniform3fv(program.uniform("u_prt_light"), 9, light.data());
+      glUniform3fv(in_use.prt_light, 9, light.data());
     }
-    const GLint base_color = program.uniform("u_base_color");
+    const GLint base_color = in_use.base_color;
     draw_mesh(item, lens, cull_rect, [&](const MeshPart& part) {
       const std::array<float, 4>& color = item.object->base_color ? *item.object->base_color : part.base_color;
       glUniform4f(base_color, color[0], color[1], color[2], color[3]);

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "core/log.h"
+#include "core/probe/brightest_components.h"
 #include "render/gl/gl_error.h"
 #include "render/layer_reuse.h"
 
@@ -38,8 +39,8 @@ std::array<float, 4> square_of(const UploadedObject& catcher) {
           static_cast<float>(centre[0] + half), static_cast<float>(centre[1] + half)};
 }
 
-// Luminance weights (Rec. 709), as the catcher's shader takes them.
-double luminance(const Vec3& rgb) { return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]; }
+// Rec. 709 luminance, the weights the catcher's shader takes.
+double luminance(const Vec3& rgb) { return rec709_luminance(rgb[0], rgb[1], rgb[2]); }
 
 // The ground catcher's ambient luminance: its normal is up, where the sky-above-the-ground model
 // gives the whole constant ambient, and the SH's terms are those of Y_0, Y_1,0 and Y_2,0 (the
