@@ -346,7 +346,7 @@ void add_blur_benchmark(CLI::App& bench) {
   command->add_option("--set", options->overrides, "override one config key (VALUE in TOML syntax); repeatable")
       ->type_name("KEY=VALUE")
       ->allow_extra_args(false);
-  cli::on_run(command, [options] { return run_blur_benchmark(*options); });
+  cli::on_run(command, [options] { return run_blur_benchmark(*options); }, cli::Failure{});
 }
 
 }  // namespace arpipe

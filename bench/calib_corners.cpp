@@ -119,7 +119,7 @@ void add_calib_corners_benchmark(CLI::App& bench) {
   command->add_option("--board", options->board_file, "the board file")->type_name("FILE");
   command->add_option("--dump", options->dump_file, "write every corner (refinement, frame, point, true and detected pixel) as a vnl table")
       ->type_name("FILE");
-  cli::on_run(command, [options] { return run_calib_corners_benchmark(*options); });
+  cli::on_run(command, [options] { return run_calib_corners_benchmark(*options); }, cli::Failure{});
 }
 
 }  // namespace arpipe

@@ -127,7 +127,7 @@ void add_calib_solve_benchmark(CLI::App& bench) {
       ->type_name("PX")
       ->check(CLI::NonNegativeNumber);
   command->add_option("--seeds", options->seeds, "noise seeds per row")->check(CLI::PositiveNumber);
-  cli::on_run(command, [options] { return run_calib_solve_benchmark(options->sigma, options->seeds); });
+  cli::on_run(command, [options] { return run_calib_solve_benchmark(options->sigma, options->seeds); }, cli::Failure{});
 }
 
 }  // namespace arpipe

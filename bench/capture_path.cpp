@@ -228,7 +228,7 @@ void add_capture_path_benchmark(CLI::App& bench) {
   command->add_option("RECORDING", options->recording, "the recording the stand-in serves");
   command->add_option("--frames", options->frames, "frames per format")->check(CLI::Range(10, 1000000));
   command->add_option("--standin", options->standin, "the V4L2 stand-in library (docs/V4L2_STANDIN.md)")->type_name("LIB");
-  cli::on_run(command, [options] { return run_capture_path_benchmark(*options); });
+  cli::on_run(command, [options] { return run_capture_path_benchmark(*options); }, cli::Failure{});
 }
 
 }  // namespace arpipe

@@ -128,7 +128,7 @@ void add_physics_benchmark(CLI::App& bench) {
       "physics", "rigid-body physics: run time per frame against bounce and landing error, per substep rate");
   auto seconds = std::make_shared<double>(10.0);
   command->add_option("--seconds", *seconds, "simulated seconds of the busy scene per row")->check(CLI::Range(0.1, 600.0));
-  cli::on_run(command, [seconds] { return run_physics_benchmark(*seconds); });
+  cli::on_run(command, [seconds] { return run_physics_benchmark(*seconds); }, cli::Failure{});
 }
 
 }  // namespace arpipe

@@ -156,7 +156,7 @@ void add_scaling_benchmark(CLI::App& bench) {
   command->add_option("--work", options->work, "where the larger captures are simulated (kept for the next run)")
       ->type_name("DIR")
       ->capture_default_str();
-  cli::on_run(command, [options] { return run_scaling_benchmark(*options); });
+  cli::on_run(command, [options] { return run_scaling_benchmark(*options); }, cli::Failure{});
 }
 
 }  // namespace arpipe

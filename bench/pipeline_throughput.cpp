@@ -141,7 +141,7 @@ void add_pipeline_benchmark(CLI::App& bench) {
   command->add_option("--soak-seconds", options->soak_seconds, "then a looped replay this long, its memory every step (0: none)")
       ->type_name("S")
       ->check(CLI::NonNegativeNumber);
-  cli::on_run(command, [options] { return run_pipeline_benchmark(*options); });
+  cli::on_run(command, [options] { return run_pipeline_benchmark(*options); }, cli::Failure{});
 }
 
 }  // namespace arpipe

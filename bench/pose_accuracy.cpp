@@ -108,7 +108,7 @@ void add_pose_benchmark(CLI::App& bench) {
       "pose", "tracking time against pose error for the detector's quad decimation and corner refinement");
   auto capture = std::make_shared<std::string>("build/default-capture");
   command->add_option("--capture", *capture, "a recording with ground truth")->type_name("DIR");
-  cli::on_run(command, [capture] { return run_pose_benchmark(*capture); });
+  cli::on_run(command, [capture] { return run_pose_benchmark(*capture); }, cli::Failure{});
 }
 
 }  // namespace arpipe

@@ -144,7 +144,7 @@ void add_probe_benchmark(CLI::App& bench) {
   auto options = std::make_shared<Options>();
   command->add_option("--capture", options->capture, "the probe-indoor capture (or one like it)")->type_name("DIR");
   command->add_option("--repeats", options->repeats, "runs over the capture per row")->check(CLI::PositiveNumber);
-  cli::on_run(command, [options] { return run_probe_benchmark(options->capture, options->repeats); });
+  cli::on_run(command, [options] { return run_probe_benchmark(options->capture, options->repeats); }, cli::Failure{});
 }
 
 }  // namespace arpipe

@@ -147,7 +147,7 @@ void add_proxies_benchmark(CLI::App& bench) {
   command->add_option("--capture", options->capture, "a capture with ground_truth_coverage/")->type_name("DIR");
   command->add_option("--config", options->config, "the config with the proxies")->type_name("FILE");
   command->add_option("--repeats", options->repeats, "times each capture is drawn for the timings")->check(CLI::Range(1, 100));
-  cli::on_run(command, [options] { return run_proxies_benchmark(options->capture, options->config, options->repeats); });
+  cli::on_run(command, [options] { return run_proxies_benchmark(options->capture, options->config, options->repeats); }, cli::Failure{});
 }
 
 }  // namespace arpipe

@@ -177,7 +177,7 @@ void add_prt_benchmark(CLI::App& bench) {
                       "then the run-time cost: the render stage with PRT against per-pixel Lambert + SH irradiance on "
                       "the same meshes, N frames each (0: skip)")
       ->check(CLI::Range(0, 10000));
-  cli::on_run(command, [options] { return run_prt_benchmark(*options); });
+  cli::on_run(command, [options] { return run_prt_benchmark(*options); }, cli::Failure{});
 }
 
 }  // namespace arpipe

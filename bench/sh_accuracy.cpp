@@ -352,7 +352,7 @@ void add_sh_benchmark(CLI::App& bench) {
   command->add_option("--samples", options->samples, "samples per axis of the jittered and product-rule projections")
       ->check(CLI::Range(2, 2000));
   command->add_option("--seed", options->seed, "jitter seed");
-  cli::on_run(command, [options] { return run_sh_benchmark(options->samples, options->seed); });
+  cli::on_run(command, [options] { return run_sh_benchmark(options->samples, options->seed); }, cli::Failure{});
 }
 
 }  // namespace arpipe

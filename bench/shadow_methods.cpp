@@ -76,7 +76,7 @@ void add_shadows_benchmark(CLI::App& bench) {
   auto options = std::make_shared<Options>();
   command->add_option("--frames", options->frames, "frames per row")->check(CLI::Range(1, 1000));
   command->add_option("--scenes", options->scenes, "where the simulator scenes are")->type_name("DIR");
-  cli::on_run(command, [options] { return run_shadows_benchmark(options->frames, options->scenes); });
+  cli::on_run(command, [options] { return run_shadows_benchmark(options->frames, options->scenes); }, cli::Failure{});
 }
 
 }  // namespace arpipe

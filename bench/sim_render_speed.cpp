@@ -122,7 +122,7 @@ void add_sim_render_benchmark(CLI::App& bench) {
       ->check(CLI::PositiveNumber);
   command->add_option("--frames", options->frames, "frames per scene")->check(CLI::PositiveNumber);
   command->add_option("--threads", options->threads, "render threads (0: every core)")->check(CLI::NonNegativeNumber);
-  cli::on_run(command, [options] { return run_sim_render_benchmark(*options); });
+  cli::on_run(command, [options] { return run_sim_render_benchmark(*options); }, cli::Failure{});
 }
 
 }  // namespace arpipe

@@ -96,7 +96,7 @@ void add_sun_benchmark(CLI::App& bench) {
   auto options = std::make_shared<Options>();
   command->add_option("--calls", options->calls, "calls per timed repeat")->check(CLI::PositiveNumber);
   command->add_option("--repeats", options->repeats, "timed repeats (the median is printed)")->type_name("R")->check(CLI::PositiveNumber);
-  cli::on_run(command, [options] { return run_sun_benchmark(options->calls, options->repeats); });
+  cli::on_run(command, [options] { return run_sun_benchmark(options->calls, options->repeats); }, cli::Failure{});
 }
 
 }  // namespace arpipe

@@ -15,7 +15,7 @@
 #include "render/gl/fullscreen_triangle.h"
 #include "render/gl/gl_error.h"
 #include "render/gl/render_errors.h"
-#include "render/pixel_rect.h"
+#include "core/image/pixel_rect.h"
 
 namespace arpipe {
 namespace {

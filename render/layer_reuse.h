@@ -21,7 +21,7 @@
 #include "core/geometry/se3.h"
 #include "core/pipeline/frame_context.h"
 #include "render/object_renderer.h"
-#include "render/pixel_rect.h"
+#include "core/image/pixel_rect.h"
 
 namespace arpipe {
 

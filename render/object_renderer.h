@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "render/gl/gl_program.h"
-#include "render/pixel_rect.h"
+#include "core/image/pixel_rect.h"
 #include "render/lens/lens_projection.h"
 #include "render/uploaded_objects.h"
 #include "render/row_poses.h"

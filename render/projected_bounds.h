@@ -8,7 +8,7 @@
 #include "core/geometry/camera_model.h"
 #include "core/geometry/se3.h"
 #include "core/scene/mesh.h"
-#include "render/pixel_rect.h"
+#include "core/image/pixel_rect.h"
 
 namespace arpipe {
 

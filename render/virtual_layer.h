@@ -4,7 +4,7 @@
 
 #include "render/gl/egl_context.h"
 #include "render/gl/gl_objects.h"
-#include "render/pixel_rect.h"
+#include "core/image/pixel_rect.h"
 
 namespace arpipe {
 

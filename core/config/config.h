@@ -139,6 +139,9 @@ struct TrackConfig {
   // Frames without a detection that still get a pose, predicted at constant velocity from the last
   // two measured ones (state Predicted); beyond this the state is Lost. 0: no prediction.
   int max_predicted_frames = 3;
+  // While the previous frame was tracked, look for the tags only in a window around where the
+  // bundle is expected (the whole frame when that finds fewer of its tags than should be in view).
+  bool search_window = true;
 
   bool operator==(const TrackConfig&) const = default;
 };
@@ -162,6 +165,8 @@ void visit(V& v, TrackConfig& s) {
   // A second of prediction at 30 fps is already far beyond what constant velocity predicts well.
   v.key("max_predicted_frames", s.max_predicted_frames, IntRange{0, 30},
         "frames without a detection whose pose is predicted at constant velocity (0: none)");
+  v.key("search_window", s.search_window,
+        "after a tracked frame, search only around where the bundle is expected (the whole frame when that falls short)");
   v.sections("bundle", s.bundle, "the anchor: one [[track.bundle]] per tag, placed in the world (anchor) frame, lying in z = 0");
 }
 

@@ -557,4 +557,27 @@ std::optional<Vec2> CameraModel::normalize(const Vec2& pixel) const {
   return Vec2{(*direction)[0] / (*direction)[2], (*direction)[1] / (*direction)[2]};
 }
 
+std::optional<Vec2> CameraModel::normalize_near(const Vec2& pixel, const Vec2& near) const {
+  constexpr int kMaxSteps = 8;
+  constexpr double kConvergedPx = 1e-9;
+  if (!mrcal_->metadata.has_gradients || !std::isfinite(near[0]) || !std::isfinite(near[1])) return normalize(pixel);
+  double x = near[0], y = near[1];
+  for (int step = 0; step < kMaxSteps; ++step) {
+    const mrcal_point3_t p{.x = x, .y = y, .z = 1.0};
+    mrcal_point2_t q{};
+    mrcal_point3_t dq_dp[2]{};  // rows: d(qx)/dp, d(qy)/dp
+    if (!mrcal_project(&q, dq_dp, nullptr, &p, 1, &mrcal_->lensmodel, intrinsics_.data())) break;
+    const double ex = pixel[0] - q.x, ey = pixel[1] - q.y;
+    if (!std::isfinite(ex) || !std::isfinite(ey)) break;
+    if (std::abs(ex) < kConvergedPx && std::abs(ey) < kConvergedPx) return Vec2{x, y};
+    // With z fixed at 1, the 2x2 Jacobian of the pixel in (x, y).
+    const double a = dq_dp[0].x, b = dq_dp[0].y, c = dq_dp[1].x, d = dq_dp[1].y;
+    const double det = a * d - b * c;
+    if (!(std::abs(det) > 1e-12)) break;
+    x += (d * ex - b * ey) / det;
+    y += (a * ey - c * ex) / det;
+  }
+  return normalize(pixel);
+}
+
 }  // namespace arpipe

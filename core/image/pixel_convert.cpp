@@ -25,19 +25,22 @@ inline uint8_t rgb_to_u(int r, int g, int b) { return clamp8(((-38 * r - 74 * g 
 inline uint8_t rgb_to_v(int r, int g, int b) { return clamp8(((112 * r - 94 * g - 18 * b + 128) >> 8) + 128); }
 }  // namespace
 
-void to_grey(const Frame& f, std::vector<uint8_t>& out) {
+void to_grey(const Frame& f, std::vector<uint8_t>& out) { to_grey(f, PixelRect::full(f.width, f.height), out); }
+
+void to_grey(const Frame& f, const PixelRect& rect, std::vector<uint8_t>& out) {
   out.resize(size_t(f.width) * f.height);
-  for (int y = 0; y < f.height; ++y) {
+  const PixelRect r = rect.intersected(PixelRect::full(f.width, f.height));
+  for (int y = r.y; y < r.bottom(); ++y) {
     const uint8_t* row = f.data.data() + size_t(y) * f.bytes_per_line;
     uint8_t* dst = out.data() + size_t(y) * f.width;
     switch (f.format) {
       case PixelFormat::GREY:
-      case PixelFormat::NV12: std::memcpy(dst, row, size_t(f.width)); break;
+      case PixelFormat::NV12: std::memcpy(dst + r.x, row + r.x, size_t(r.width)); break;
       case PixelFormat::YUYV:
-        for (int x = 0; x < f.width; ++x) dst[x] = row[2 * x];
+        for (int x = r.x; x < r.right(); ++x) dst[x] = row[2 * x];
         break;
       case PixelFormat::RGB24:
-        for (int x = 0; x < f.width; ++x) dst[x] = rgb_to_full_range_luma(row[3 * x], row[3 * x + 1], row[3 * x + 2]);
+        for (int x = r.x; x < r.right(); ++x) dst[x] = rgb_to_full_range_luma(row[3 * x], row[3 * x + 1], row[3 * x + 2]);
         break;
     }
   }

@@ -6,12 +6,16 @@
 #include <vector>
 
 #include "core/frame.h"
+#include "core/image/pixel_rect.h"
 
 namespace arpipe {
 
 // Writes width*height bytes of luma (no stride) into out: the Y plane as it is for YUV formats
 // (limited range, 16..235), full-range BT.601 luma for RGB24 and GREY (0..255).
 void to_grey(const Frame& frame, std::vector<uint8_t>& out);
+// The same for the pixels of `rect` alone (clipped to the frame), at their places in out, which
+// is sized width*height (its other bytes keep what they held).
+void to_grey(const Frame& frame, const PixelRect& rect, std::vector<uint8_t>& out);
 // Writes width*height*3 bytes of RGB (no stride) into out. BT.601 limited range for YUV formats;
 // GREY is full range (R = G = B = the grey value).
 void to_rgb24(const Frame& frame, std::vector<uint8_t>& out);

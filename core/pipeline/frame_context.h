@@ -44,7 +44,12 @@ struct PoseEstimate {
   int frames_since_measured = 0;
   double predicted_uncertainty_deg = 0;
   double predicted_uncertainty_mm = 0;  // camera centre
-  std::vector<TagObservation> tags;  // every detection of the bundle's family on this frame
+  // Every detection of the bundle's family on this frame; only those inside the search window
+  // when the window sufficed (searched_window_only).
+  std::vector<TagObservation> tags;
+  // The detector ran only on the window around the expected bundle (track.search_window), and
+  // that found every tag of the bundle expected in view.
+  bool searched_window_only = false;
 };
 
 struct StageTiming {

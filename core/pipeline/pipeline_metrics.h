@@ -25,6 +25,9 @@ struct PipelineMetrics {
   uint64_t frames_tracked = 0;
   uint64_t frames_predicted = 0;  // no detection, pose extrapolated (TrackState::Predicted)
   uint64_t frames_lost = 0;
+  // Tracked frames whose tags were found in the window around the expected bundle alone
+  // (track.search_window): the detector did not look at the rest of the frame.
+  uint64_t frames_tracked_in_window = 0;
   // Frames whose first stage ran on the helper thread beside the previous frame's later stages
   // (pipeline.overlap_first_stage).
   uint64_t frames_overlapped = 0;

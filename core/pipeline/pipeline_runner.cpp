@@ -159,6 +159,7 @@ void PipelineRunner::finish_frame(FrameContext& ctx, size_t first_stage) {
       if (!t.skipped.empty()) ++stats.skips[t.skipped];
     }
     if (ctx.pose.state == TrackState::Tracking) ++metrics_.frames_tracked;
+    if (ctx.pose.state == TrackState::Tracking && ctx.pose.searched_window_only) ++metrics_.frames_tracked_in_window;
     if (ctx.pose.state == TrackState::Predicted) ++metrics_.frames_predicted;
     if (ctx.pose.state == TrackState::Lost) ++metrics_.frames_lost;
   }

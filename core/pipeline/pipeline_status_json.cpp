@@ -28,6 +28,7 @@ nlohmann::json pipeline_status_json(const PipelineStatus& status) {
                    {"sequence_gaps", m.sequence_gaps},
                    {"source_retries", m.source_retries},
                    {"frames_tracked", m.frames_tracked},
+                   {"frames_tracked_in_window", m.frames_tracked_in_window},
                    {"frames_predicted", m.frames_predicted},
                    {"frames_lost", m.frames_lost},
                    {"latency_ms_mean", m.latency_seconds.count()

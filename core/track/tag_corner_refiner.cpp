@@ -155,10 +155,11 @@ bool TagCornerRefiner::refine(const uint8_t* grey, int width, int height, size_t
       const Vec2 p{a[0] + t * along[0], a[1] + t * along[1]};
       const auto s = edge_offset(image, p, normal, reach);
       if (!s) continue;
-      // Straight edges of the tag are straight only after undistortion.
-      if (const auto n = camera.normalize(Vec2{p[0] + *s * normal[0], p[1] + *s * normal[1]})) {
-        edge_points.push_back(*n);
-      }
+      // Straight edges of the tag are straight only after undistortion. The points lie a few
+      // pixels apart: each starts from its neighbour's solution.
+      const Vec2 on_edge{p[0] + *s * normal[0], p[1] + *s * normal[1]};
+      const auto n = edge_points.empty() ? camera.normalize(on_edge) : camera.normalize_near(on_edge, edge_points.back());
+      if (n) edge_points.push_back(*n);
     }
     const auto line = fit_line(edge_points);
     if (!line) return false;

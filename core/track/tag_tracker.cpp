@@ -14,6 +14,7 @@
 
 #include "core/geometry/se3_interpolation.h"
 #include "core/image/pixel_convert.h"
+#include "core/image/pixel_rect.h"
 #include "core/log.h"
 #include "core/pipeline/monotonic_clock.h"
 #include "core/track/bundle_tag_geometry.h"
@@ -65,6 +66,59 @@ void validate(const Config& config, const TagDetector& detector) {
   }
 }
 
+// The bundle's corners projected with a camera pose: their bounding box in pixels, and how many tags
+// have all four corners inside the frame. nullopt when a corner is behind the camera or off the lens.
+struct ProjectedBundle {
+  double x0 = 1e18, y0 = 1e18, x1 = -1e18, y1 = -1e18;
+  int tags_in_frame = 0;
+};
+
+std::optional<ProjectedBundle> project_bundle(const CameraModel& camera, const SE3& T_cam_world,
+                                              const std::unordered_map<int, std::array<Vec3, 4>>& world_corners) {
+  ProjectedBundle bundle;
+  for (const auto& [id, corners] : world_corners) {
+    bool inside = true;
+    for (const Vec3& corner : corners) {
+      const auto pixel = camera.project(T_cam_world * corner);
+      if (!pixel) return std::nullopt;
+      const double x = (*pixel)[0], y = (*pixel)[1];
+      bundle.x0 = std::min(bundle.x0, x);
+      bundle.y0 = std::min(bundle.y0, y);
+      bundle.x1 = std::max(bundle.x1, x);
+      bundle.y1 = std::max(bundle.y1, y);
+      inside = inside && x >= 0 && y >= 0 && x <= camera.width() - 1 && y <= camera.height() - 1;
+    }
+    bundle.tags_in_frame += inside ? 1 : 0;
+  }
+  return bundle;
+}
+
+// The box grown by `margin` on each side, its left and top edges moved down and its right and bottom
+// edges up to multiples of `align`, then clipped to the frame.
+PixelRect grown_rect(const ProjectedBundle& box, double margin, int align, int width, int height) {
+  const auto down = [align](double v) { return int(std::floor(v / align)) * align; };
+  const auto up = [align](double v) { return int(std::ceil(v / align)) * align; };
+  const int left = std::clamp(down(box.x0 - margin), 0, width);
+  const int top = std::clamp(down(box.y0 - margin), 0, height);
+  const int right = std::clamp(up(box.x1 + margin), 0, width);
+  const int bottom = std::clamp(up(box.y1 + margin), 0, height);
+  return PixelRect{left, top, right - left, bottom - top};
+}
+
+// libapriltag thresholds the decimated image in tiles of 4 pixels, each against the extremes of its
+// 3x3 tiles; a window on that grid leaves every tile in it as the whole frame's.
+int tile_grid_px(double quad_decimate) {
+  const double whole = std::round(quad_decimate);
+  // 1.5 takes 3 pixels to 2: 12 pixels per 4 decimated ones.
+  return whole == quad_decimate ? 4 * int(whole) : 4 * 3 * int(std::ceil(quad_decimate));
+}
+
+// Where to look for the bundle on this frame, and how many of its tags should be found there.
+struct SearchWindow {
+  PixelRect rect;
+  int tags_in_frame = 0;
+};
+
 }  // namespace
 
 struct TagTracker::Impl {
@@ -105,6 +159,17 @@ struct TagTracker::Impl {
   // Runs the crop detector on the predicted tags' box grown by a margin; fills `detections` in
   // full-frame pixels.
   void search_near(const FrameContext& ctx, const SE3& predicted, const uint8_t* pixels, size_t stride);
+  // The frame's luma inside `rect`, converted into `grey` (the frame's size).
+  const uint8_t* luma(const Frame& frame, const PixelRect& rect) {
+    to_grey(frame, rect, grey);
+    return grey.data();
+  }
+  // Runs `with` on the rectangle of the image; fills `detections` in full-frame pixels.
+  void detect_in(TagDetector& with, const PixelRect& rect, const uint8_t* pixels, size_t stride);
+  // The frame's search window (track.search_window) for a camera at `expected`, with how many of
+  // the bundle's tags should lie wholly inside the frame; nullopt when the window would be most of
+  // the frame anyway, or the bundle does not project.
+  std::optional<SearchWindow> search_window_at(const FrameContext& ctx, const SE3& expected) const;
   // Returns a skip reason, or empty when the frame can be tracked.
   std::string why_not_trackable(const FrameContext& ctx);
 };
@@ -187,47 +252,52 @@ void TagTracker::Impl::collect(FrameContext& ctx, const uint8_t* pixels, size_t 
   }
 }
 
+void TagTracker::Impl::detect_in(TagDetector& with, const PixelRect& rect, const uint8_t* pixels, size_t stride) {
+  with.detect(pixels + size_t(rect.y) * stride + size_t(rect.x), rect.width, rect.height, stride, detections);
+  for (TagObservation& observation : detections) {
+    for (Vec2& corner : observation.corners) {
+      corner[0] += rect.x;
+      corner[1] += rect.y;
+    }
+  }
+}
+
 void TagTracker::Impl::search_near(const FrameContext& ctx, const SE3& predicted, const uint8_t* pixels,
                                    size_t stride) {
   detections.clear();
   const Frame& frame = ctx.camera;
-  double x0 = 1e18, y0 = 1e18, x1 = -1e18, y1 = -1e18;
-  for (const auto& [id, corners] : world_corners_by_id) {
-    for (const Vec3& corner : corners) {
-      const auto pixel = ctx.camera_model->project(predicted * corner);
-      if (!pixel) return;  // behind the camera or off the lens: nothing sensible to search
-      x0 = std::min(x0, (*pixel)[0]);
-      y0 = std::min(y0, (*pixel)[1]);
-      x1 = std::max(x1, (*pixel)[0]);
-      y1 = std::max(y1, (*pixel)[1]);
-    }
-  }
+  const auto box = project_bundle(*ctx.camera_model, predicted, world_corners_by_id);
+  if (!box) return;  // behind the camera or off the lens: nothing sensible to search
   // The margin covers the prediction's error and the blur's smear: half the box again each side,
   // and at least 40 px (the fastest pans of configs/sim/tag-pan.toml smear 20-30 px).
-  const double margin = std::max(40.0, 0.5 * std::max(x1 - x0, y1 - y0));
-  const int left = std::clamp(int(std::floor(x0 - margin)), 0, frame.width);
-  const int top = std::clamp(int(std::floor(y0 - margin)), 0, frame.height);
-  const int right = std::clamp(int(std::ceil(x1 + margin)), 0, frame.width);
-  const int bottom = std::clamp(int(std::ceil(y1 + margin)), 0, frame.height);
-  if (right - left < 16 || bottom - top < 16) return;
-  crop_detector->detect(pixels + size_t(top) * stride + size_t(left), right - left, bottom - top, stride, detections);
-  for (TagObservation& observation : detections) {
-    for (Vec2& corner : observation.corners) {
-      corner[0] += left;
-      corner[1] += top;
-    }
-  }
+  const double margin = std::max(40.0, 0.5 * std::max(box->x1 - box->x0, box->y1 - box->y0));
+  const PixelRect rect = grown_rect(*box, margin, 1, frame.width, frame.height);
+  if (rect.width < 16 || rect.height < 16) return;
+  detect_in(*crop_detector, rect, pixels, stride);
+}
+
+std::optional<SearchWindow> TagTracker::Impl::search_window_at(const FrameContext& ctx, const SE3& expected) const {
+  const Frame& frame = ctx.camera;
+  const auto box = project_bundle(*ctx.camera_model, expected, world_corners_by_id);
+  if (!box || box->tags_in_frame == 0) return std::nullopt;
+  // The same margin as the search near a prediction: it holds the constant-velocity prediction's
+  // error on the blur captures' fastest turns, and libapriltag's own 3x3-tile neighbourhood.
+  const double margin = std::max(40.0, 0.5 * std::max(box->x1 - box->x0, box->y1 - box->y0));
+  const PixelRect rect = grown_rect(*box, margin, tile_grid_px(config.quad_decimate), frame.width, frame.height);
+  // A window of most of the frame saves little and may cut a tag the prediction misplaced.
+  if (rect.width < 16 || rect.height < 16 || double(rect.width) * rect.height > 0.5 * frame.width * frame.height)
+    return std::nullopt;
+  return SearchWindow{rect, box->tags_in_frame};
 }
 
 void TagTracker::Impl::track(FrameContext& ctx) {
   const Frame& frame = ctx.camera;
   const uint8_t* pixels = frame.data.data();
   size_t stride = frame.bytes_per_line;
-  if (frame.format != PixelFormat::GREY) {
-    to_grey(frame, grey);
-    pixels = grey.data();
-    stride = static_cast<size_t>(frame.width);
-  }
+  // Other formats' luma is taken (luma()) only where the detector and the refiner will look: the
+  // window, or the whole frame.
+  const bool needs_luma = frame.format != PixelFormat::GREY;
+  if (needs_luma) stride = static_cast<size_t>(frame.width);
   const int64_t time_ns = frame.meta.exposure_mid_ns();
   // Dropped frames count: the prediction reaches that much further. (Capped so it cannot overflow.)
   frames_since_measured = std::min(frames_since_measured + 1 + int(std::min<uint64_t>(ctx.dropped_before, 1000)),
@@ -241,11 +311,31 @@ void TagTracker::Impl::track(FrameContext& ctx) {
     predicted = pose_at_time(*measured_older, *measured_newer, time_ns);
   }
 
-  detector->detect(pixels, frame.width, frame.height, stride, detections);
-  collect(ctx, pixels, stride);
-  auto solution = correspondences.empty()
-                      ? std::nullopt
-                      : solve_tag_pose(*ctx.camera_model, correspondences, config.ambiguity_ratio, previous_pose);
+  // After a tracked frame the bundle is most likely near where the motion puts it: the window
+  // suffices when it holds every tag of the bundle that should be in the frame.
+  std::optional<TagPoseSolution> solution;
+  std::optional<SearchWindow> window;
+  if (config.search_window && previous_pose) window = search_window_at(ctx, predicted ? *predicted : *previous_pose);
+  if (window) {
+    if (needs_luma) pixels = luma(frame, window->rect);
+    detect_in(*detector, window->rect, pixels, stride);
+    collect(ctx, pixels, stride);
+    if (!correspondences.empty())
+      solution = solve_tag_pose(*ctx.camera_model, correspondences, config.ambiguity_ratio, previous_pose);
+    if (solution && solution->tags_used >= window->tags_in_frame) {
+      ctx.pose.searched_window_only = true;
+    } else {
+      solution.reset();
+      ctx.pose.tags.clear();
+    }
+  }
+  if (!ctx.pose.searched_window_only) {
+    if (needs_luma) pixels = luma(frame, PixelRect::full(frame.width, frame.height));
+    detector->detect(pixels, frame.width, frame.height, stride, detections);
+    collect(ctx, pixels, stride);
+    if (!correspondences.empty())
+      solution = solve_tag_pose(*ctx.camera_model, correspondences, config.ambiguity_ratio, previous_pose);
+  }
   bool searched = false;
   if (!solution && predicted && crop_detector) {
     // Search near the prediction: a blurred tag the full-frame pass missed.

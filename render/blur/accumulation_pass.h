@@ -7,7 +7,7 @@
 #include "render/gl/egl_context.h"
 #include "render/gl/gl_objects.h"
 #include "render/gl/gl_program.h"
-#include "render/pixel_rect.h"
+#include "core/image/pixel_rect.h"
 #include "render/gl/texture_target.h"
 
 namespace arpipe {

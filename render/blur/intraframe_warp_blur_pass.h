@@ -10,7 +10,7 @@
 #include "core/motion/intraframe_warp_plan.h"
 #include "render/gl/gl_objects.h"
 #include "render/gl/gl_program.h"
-#include "render/pixel_rect.h"
+#include "core/image/pixel_rect.h"
 
 namespace arpipe {
 

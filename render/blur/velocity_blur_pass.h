@@ -10,7 +10,7 @@
 
 #include "render/gl/gl_objects.h"
 #include "render/gl/gl_program.h"
-#include "render/pixel_rect.h"
+#include "core/image/pixel_rect.h"
 
 namespace arpipe {
 

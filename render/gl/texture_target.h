@@ -5,7 +5,7 @@
 #include <GLES3/gl3.h>
 
 #include "render/gl/gl_objects.h"
-#include "render/pixel_rect.h"
+#include "core/image/pixel_rect.h"
 
 namespace arpipe {
 

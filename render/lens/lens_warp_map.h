@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "core/geometry/camera_model.h"
-#include "render/pixel_rect.h"
+#include "core/image/pixel_rect.h"
 
 namespace arpipe {
 

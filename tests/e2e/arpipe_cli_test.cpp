@@ -156,6 +156,15 @@ TEST_F(ArpipeCli, BenchBlurPrintsItsTableOnAShortCapture) {
   EXPECT_NE(err.find("missing"), std::string::npos) << err;
 }
 
+// A config that cannot be read is an error naming it (exit 1), not an uncaught exception.
+TEST_F(ArpipeCli, BenchPipelineNamesAMissingConfig) {
+  if (!benchmarks_built()) GTEST_SKIP() << "arpipe built without the benchmarks";
+  std::string err;
+  EXPECT_EQ(run({"bench", "pipeline", "--config", (dir_ / "missing.toml").string(), "--frames", "1"}, nullptr, &err),
+            1);
+  EXPECT_NE(err.find("missing.toml"), std::string::npos) << err;
+}
+
 TEST_F(ArpipeCli, SimulateNamesTheBadSceneFileAndKey) {
   std::ofstream(dir_ / "bad.toml") << "[camera]\nexposure_ms = 0\n";
   std::string err;

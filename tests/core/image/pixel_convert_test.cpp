@@ -207,6 +207,28 @@ TEST(PixelConvert, ToGreyTakesTheLumaPlaneOfYuvFrames) {
   }
 }
 
+// The tracker's search window converts only its rectangle: those bytes are the whole frame's
+// conversion, the others keep what they held, and a rectangle reaching out of the frame is clipped.
+TEST(PixelConvert, ToGreyOfARectangleWritesThatRectangleOnly) {
+  const int w = 12, h = 6;
+  std::vector<uint8_t> rgb(size_t(w) * h * 3);
+  for (size_t i = 0; i < rgb.size(); ++i) rgb[i] = uint8_t(i * 37 % 251);
+  for (const PixelFormat format : {PixelFormat::YUYV, PixelFormat::NV12, PixelFormat::RGB24, PixelFormat::GREY}) {
+    const Frame f = from_rgb24(rgb.data(), w, h, format);
+    std::vector<uint8_t> whole;
+    to_grey(f, whole);
+    const PixelRect rect{3, 2, 20, 3};  // columns 3..11 once clipped, rows 2..4
+    std::vector<uint8_t> part(size_t(w) * h, uint8_t{7});
+    to_grey(f, rect, part);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const size_t i = size_t(y) * w + x;
+        const bool inside = x >= 3 && y >= 2 && y < 5;
+        EXPECT_EQ(part[i], inside ? whole[i] : uint8_t{7}) << pixel_format_name(format) << " " << x << "," << y;
+      }
+  }
+}
+
 TEST(PixelConvert, Nv12ChromaBelongsToItsOwnTwoByTwoBlock) {
   // Four blocks of different colours in a 4x4 image: each must decode with its own chroma.
   const Rgb colours[2][2] = {{{255, 0, 0}, {0, 255, 0}}, {{0, 0, 255}, {255, 255, 0}}};

@@ -1,5 +1,6 @@
 // An axis-aligned rectangle of whole pixels in image coordinates (x right, y down): the region of
-// the frame that the virtual layer covers and to which GL work and readback are restricted.
+// the frame that the virtual layer covers and to which GL work and readback are restricted, or the
+// window the tag detector searches.
 #pragma once
 
 #include <algorithm>
