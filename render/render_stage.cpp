@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <numbers>
@@ -201,6 +202,14 @@ void RenderStage::process(FrameContext& ctx) noexcept {
   }
 }
 
+namespace {
+// Process-wide, so that no two drawings (of this stage or of one built by a reload) share a number.
+uint64_t next_layer_generation() {
+  static std::atomic<uint64_t> last{0};
+  return ++last;
+}
+}  // namespace
+
 RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
   if (!ctx.camera_model) throw RenderError("the frame has no camera model");
   const CameraModel& camera = *ctx.camera_model;
@@ -366,7 +375,8 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
   // The work is queued until something waits for it; waiting here keeps the stage timings honest.
   glFinish();
   check_gl("drawing the virtual layer");
-  ctx.virtual_layer = {drawn_texture, camera.width(), camera.height(), rect.x, rect.y, rect.width, rect.height};
+  ctx.virtual_layer = {drawn_texture, camera.width(), camera.height(), rect.x,
+                       rect.y,        rect.width,     rect.height,     next_layer_generation()};
   ctx.virtual_layer_drawn = true;
   ctx.blur_method = std::string(blur_method_name(drawn.method));
   ctx.blur_samples = drawn.samples;

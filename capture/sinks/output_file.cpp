@@ -90,6 +90,7 @@ OutputFile::OutputFile(const std::filesystem::path& path, std::string_view confi
     fd_ = ::open(path_.c_str(), O_WRONLY | O_CLOEXEC);
     if (fd_ < 0) throw fail(fmt::format("cannot open for writing: {}", std::strerror(errno)));
     pipe_like_ = S_ISFIFO(st.st_mode) || S_ISSOCK(st.st_mode);
+    fifo_ = S_ISFIFO(st.st_mode);
     committed_ = true;
   }
 }
@@ -118,6 +119,20 @@ bool OutputFile::commit(std::string& error) noexcept {
 }
 
 int OutputFile::append(std::initializer_list<std::span<const uint8_t>> parts) noexcept {
+  if (fd_ < 0) {
+    // A FIFO whose reader left: the next reader (a player started again) is found by opening it
+    // anew, without blocking; none yet is the same broken pipe as before.
+    if (!fifo_) return EBADF;
+    fd_ = ::open(path_.c_str(), O_WRONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd_ < 0) return errno == ENXIO ? EPIPE : errno;
+    const int flags = ::fcntl(fd_, F_GETFL);
+    if (flags < 0 || ::fcntl(fd_, F_SETFL, flags & ~O_NONBLOCK) != 0) {
+      const int error = errno;
+      ::close(fd_);
+      fd_ = -1;
+      return error;
+    }
+  }
   if (cut_back_pending_) {
     if (::ftruncate(fd_, off_t(end_)) != 0) return errno;
     cut_back_pending_ = false;
@@ -135,6 +150,12 @@ int OutputFile::append(std::initializer_list<std::span<const uint8_t>> parts) no
   }
   if (error) {
     if (regular_ && at != end_ && ::ftruncate(fd_, off_t(end_)) != 0) cut_back_pending_ = true;
+    // The pipe keeps what the reader that left did not read while any end is open: closed, its
+    // buffer goes, so the next reader starts with the next record, not the rest of this one.
+    if (fifo_ && error == EPIPE) {
+      ::close(fd_);
+      fd_ = -1;
+    }
     return error;
   }
   if (regular_) end_ = at;

@@ -31,7 +31,8 @@ class OutputFile {
 
   // Appends one record made of parts, all or nothing: returns 0, or the errno of the failed write,
   // after cutting a regular file back to the end of its last whole record. A stream (FIFO, socket)
-  // cannot be cut back; a broken pipe (EPIPE) is returned without raising SIGPIPE.
+  // cannot be cut back; a broken pipe (EPIPE) is returned without raising SIGPIPE. A FIFO is then
+  // closed, dropping what its reader left unread, and opened again when a new reader has come.
   int append(std::initializer_list<std::span<const uint8_t>> parts) noexcept;
 
   bool is_regular() const { return regular_; }
@@ -47,6 +48,7 @@ class OutputFile {
   int fd_ = -1;
   bool regular_ = true;
   bool pipe_like_ = false;           // FIFO or socket: a reader that leaves raises SIGPIPE
+  bool fifo_ = false;                // reopened after its reader left (fd_ = -1 until then)
   bool committed_ = false;
   bool cut_back_pending_ = false;    // a failed write could not be cut back yet
   uint64_t end_ = 0;                 // end of the last whole record

@@ -71,6 +71,9 @@ struct VirtualLayerTexture {
   int y = 0;
   int rect_width = 0;
   int rect_height = 0;
+  // Which drawing this is: a new number (never 0) each time the render stage draws, the same when
+  // it hands the last layer on again, so the composite need not read it back again.
+  uint64_t generation = 0;
 };
 
 struct FrameContext {
