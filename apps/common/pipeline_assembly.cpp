@@ -119,10 +119,10 @@ std::unique_ptr<PipelineRunner> assemble_pipeline(const Config& config) {
 
 std::string describe_metrics(const PipelineMetrics& m) {
   std::string text = fmt::format(
-      "{} frames in, {} out in {:.2f} s ({:.1f} frames/s); tracked {} ({} in the search window alone), predicted {}, "
-      "lost {}; sequence gaps {}, queue drops {}, source retries {}",
+      "{} frames in, {} out in {:.2f} s ({:.1f} frames/s); tracked {} ({} in the search window alone, {} still), "
+      "predicted {}, lost {}; sequence gaps {}, queue drops {}, source retries {}",
       m.frames_in, m.frames_out, m.wall_seconds, m.fps(), m.frames_tracked, m.frames_tracked_in_window,
-      m.frames_predicted, m.frames_lost,
+      m.frames_still, m.frames_predicted, m.frames_lost,
       m.sequence_gaps, m.queue_drops, m.source_retries);
   for (const auto& [name, stats] : m.stages) {
     text += fmt::format("; {} {:.2f} ms/frame", name, stats.runs ? stats.total_ms / double(stats.runs) : 0.0);

@@ -142,6 +142,9 @@ struct TrackConfig {
   // While the previous frame was tracked, look for the tags only in a window around where the
   // bundle is expected (the whole frame when that finds fewer of its tags than should be in view).
   bool search_window = true;
+  // A frame whose tags' patch moved less than this (pixels, at the patch's corners, since the last
+  // detection) keeps the last detection's pose without detecting again. 0: detect every frame.
+  double still_px = 0.05;
 
   bool operator==(const TrackConfig&) const = default;
 };
@@ -167,6 +170,8 @@ void visit(V& v, TrackConfig& s) {
         "frames without a detection whose pose is predicted at constant velocity (0: none)");
   v.key("search_window", s.search_window,
         "after a tracked frame, search only around where the bundle is expected (the whole frame when that falls short)");
+  v.key("still_px", s.still_px, NumberRange::closed(0, 1).in("pixels"),
+        "a frame whose tags moved less than this (pixels) since the last detection keeps its pose (0: detect every frame)");
   v.sections("bundle", s.bundle, "the anchor: one [[track.bundle]] per tag, placed in the world (anchor) frame, lying in z = 0");
 }
 

@@ -50,6 +50,9 @@ struct PoseEstimate {
   // The detector ran only on the window around the expected bundle (track.search_window), and
   // that found every tag of the bundle expected in view.
   bool searched_window_only = false;
+  // The tags' patch had not moved since the last detection (track.still_px): this is that
+  // detection's pose and tags, not detected again.
+  bool image_still = false;
 };
 
 struct StageTiming {

@@ -28,6 +28,8 @@ struct PipelineMetrics {
   // Tracked frames whose tags were found in the window around the expected bundle alone
   // (track.search_window): the detector did not look at the rest of the frame.
   uint64_t frames_tracked_in_window = 0;
+  // Tracked frames whose tags had not moved (track.still_px): the last detection's pose, kept.
+  uint64_t frames_still = 0;
   // Frames whose first stage ran on the helper thread beside the previous frame's later stages
   // (pipeline.overlap_first_stage).
   uint64_t frames_overlapped = 0;

@@ -160,6 +160,7 @@ void PipelineRunner::finish_frame(FrameContext& ctx, size_t first_stage) {
     }
     if (ctx.pose.state == TrackState::Tracking) ++metrics_.frames_tracked;
     if (ctx.pose.state == TrackState::Tracking && ctx.pose.searched_window_only) ++metrics_.frames_tracked_in_window;
+    if (ctx.pose.state == TrackState::Tracking && ctx.pose.image_still) ++metrics_.frames_still;
     if (ctx.pose.state == TrackState::Predicted) ++metrics_.frames_predicted;
     if (ctx.pose.state == TrackState::Lost) ++metrics_.frames_lost;
   }

@@ -29,6 +29,7 @@ nlohmann::json pipeline_status_json(const PipelineStatus& status) {
                    {"source_retries", m.source_retries},
                    {"frames_tracked", m.frames_tracked},
                    {"frames_tracked_in_window", m.frames_tracked_in_window},
+                   {"frames_still", m.frames_still},
                    {"frames_predicted", m.frames_predicted},
                    {"frames_lost", m.frames_lost},
                    {"latency_ms_mean", m.latency_seconds.count()

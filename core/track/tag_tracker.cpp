@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/geometry/se3_interpolation.h"
+#include "core/image/image_motion.h"
 #include "core/image/pixel_convert.h"
 #include "core/image/pixel_rect.h"
 #include "core/log.h"
@@ -139,6 +140,13 @@ struct TagTracker::Impl {
   std::unordered_map<int, size_t> correspondence_by_id;
 
   std::optional<SE3> previous_pose;  // set only while the previous frame was tracked
+  // The last detection's tags' patch and pose (track.still_px), while frames since are tracked.
+  struct StillReference {
+    PixelRect box;
+    std::vector<uint8_t> luma;  // box.width x box.height
+    PoseEstimate pose;
+  };
+  std::optional<StillReference> still;
   // The last two measured poses at their frames' mid-exposure (older first), and the frames since
   // the newer one; prediction needs both.
   std::optional<TimedPose> measured_older, measured_newer;
@@ -149,6 +157,7 @@ struct TagTracker::Impl {
   void track(FrameContext& ctx);
   void forget_motion() {
     previous_pose.reset();
+    still.reset();
     measured_older.reset();
     measured_newer.reset();
     frames_since_measured = 0;
@@ -170,6 +179,13 @@ struct TagTracker::Impl {
   // the bundle's tags should lie wholly inside the frame; nullopt when the window would be most of
   // the frame anyway, or the bundle does not project.
   std::optional<SearchWindow> search_window_at(const FrameContext& ctx, const SE3& expected) const;
+  // Whether the last detection's patch is unchanged in this frame (then ctx.pose is its pose).
+  bool keep_still_pose(FrameContext& ctx, const std::optional<SE3>& predicted, const uint8_t*& pixels, size_t stride,
+                       bool needs_luma, int64_t time_ns);
+  // Keeps this detection's patch and pose for the frames after it.
+  void remember_still(const FrameContext& ctx, const uint8_t* pixels, size_t stride);
+  // Records a pose measured (or kept) at time_ns for the prediction.
+  void measured(const SE3& T_cam_world, int64_t time_ns);
   // Returns a skip reason, or empty when the frame can be tracked.
   std::string why_not_trackable(const FrameContext& ctx);
 };
@@ -290,6 +306,73 @@ std::optional<SearchWindow> TagTracker::Impl::search_window_at(const FrameContex
   return SearchWindow{rect, box->tags_in_frame};
 }
 
+bool TagTracker::Impl::keep_still_pose(FrameContext& ctx, const std::optional<SE3>& predicted, const uint8_t*& pixels,
+                                       size_t stride, bool needs_luma, int64_t time_ns) {
+  if (!(config.still_px > 0) || !still || !previous_pose) return false;
+  const Frame& frame = ctx.camera;
+  // A camera still moving by the last two measurements is not checked: it would pay for the check
+  // and then for the detection. (It must slow down first: a kept pose predicts no motion.)
+  if (predicted) {
+    const auto moved = project_bundle(*ctx.camera_model, *predicted, world_corners_by_id);
+    const auto kept = project_bundle(*ctx.camera_model, still->pose.T_cam_world, world_corners_by_id);
+    if (!moved || !kept || std::max({std::abs(moved->x0 - kept->x0), std::abs(moved->x1 - kept->x1),
+                                     std::abs(moved->y0 - kept->y0), std::abs(moved->y1 - kept->y1)}) > 0.5)
+      return false;
+  }
+  const PixelRect& box = still->box;
+  if (box.right() > frame.width || box.bottom() > frame.height) return false;
+  if (needs_luma) pixels = luma(frame, box);
+  const uint8_t* current = pixels + size_t(box.y) * stride + size_t(box.x);
+  const std::optional<PatchMotion> motion =
+      patch_motion(still->luma.data(), size_t(box.width), current, stride, box.width, box.height);
+  // More than this share of pixels the motion cannot explain: something crossed the tags. More
+  // than this change of contrast: not the same picture (a flat one fits with a gain of -1), or an
+  // exposure step worth detecting again.
+  constexpr double kMaxOutlierFraction = 0.005;
+  constexpr double kMaxGain = 0.25;
+  if (!motion || !(motion->max_corner_px < config.still_px) || !(motion->outlier_fraction < kMaxOutlierFraction) ||
+      !(std::abs(motion->gain) < kMaxGain))
+    return false;
+  ctx.pose = still->pose;
+  ctx.pose.image_still = true;
+  measured(ctx.pose.T_cam_world, time_ns);
+  log::debug("track: frame {}: still ({:.3f} px since the last detection)", ctx.input_index, motion->max_corner_px);
+  return true;
+}
+
+void TagTracker::Impl::remember_still(const FrameContext& ctx, const uint8_t* pixels, size_t stride) {
+  still.reset();
+  if (!(config.still_px > 0) || ctx.pose.tags.empty()) return;
+  const Frame& frame = ctx.camera;
+  ProjectedBundle box;
+  for (const TagObservation& tag : ctx.pose.tags)
+    for (const Vec2& corner : tag.corners) {
+      box.x0 = std::min(box.x0, corner[0]);
+      box.y0 = std::min(box.y0, corner[1]);
+      box.x1 = std::max(box.x1, corner[0]);
+      box.y1 = std::max(box.y1, corner[1]);
+    }
+  // A few pixels beyond the corners: the border's outer edges are in it, whichever way it moves.
+  const PixelRect rect = grown_rect(box, 4.0, 1, frame.width, frame.height);
+  if (rect.width < 16 || rect.height < 16) return;
+  StillReference reference{rect, std::vector<uint8_t>(size_t(rect.width) * size_t(rect.height)), ctx.pose};
+  for (int y = 0; y < rect.height; ++y)
+    std::copy_n(pixels + size_t(rect.y + y) * stride + size_t(rect.x), size_t(rect.width),
+                reference.luma.data() + size_t(y) * size_t(rect.width));
+  still = std::move(reference);
+}
+
+void TagTracker::Impl::measured(const SE3& T_cam_world, int64_t time_ns) {
+  previous_pose = T_cam_world;
+  if (measured_newer && time_ns > measured_newer->time_ns) {
+    measured_older = measured_newer;
+  } else {
+    measured_older.reset();  // times out of order: no velocity from these two
+  }
+  measured_newer = TimedPose{time_ns, T_cam_world};
+  frames_since_measured = 0;
+}
+
 void TagTracker::Impl::track(FrameContext& ctx) {
   const Frame& frame = ctx.camera;
   const uint8_t* pixels = frame.data.data();
@@ -310,6 +393,9 @@ void TagTracker::Impl::track(FrameContext& ctx) {
       time_ns > measured_newer->time_ns) {
     predicted = pose_at_time(*measured_older, *measured_newer, time_ns);
   }
+
+  // A still camera: the tags have not moved since they were last detected.
+  if (keep_still_pose(ctx, predicted, pixels, stride, needs_luma, time_ns)) return;
 
   // After a tracked frame the bundle is most likely near where the motion puts it: the window
   // suffices when it holds every tag of the bundle that should be in the frame.
@@ -359,6 +445,7 @@ void TagTracker::Impl::track(FrameContext& ctx) {
     ctx.pose.predicted_uncertainty_mm =
         1e3 * norm(predicted->inverse().translation() - measured_newer->T_cam_world.inverse().translation());
     previous_pose.reset();
+    still.reset();
     log::debug("track: frame {}: predicted, {} frames since measured (+-{:.2f} deg, {:.1f} mm)", ctx.input_index,
                frames_since_measured, ctx.pose.predicted_uncertainty_deg, ctx.pose.predicted_uncertainty_mm);
     return;
@@ -366,6 +453,7 @@ void TagTracker::Impl::track(FrameContext& ctx) {
   if (!solution) {
     ctx.pose.state = TrackState::Lost;
     previous_pose.reset();
+    still.reset();
     // Once the prediction has run out, the old motion says nothing about the next acquisition.
     if (frames_since_measured > config.max_predicted_frames) {
       measured_older.reset();
@@ -380,14 +468,8 @@ void TagTracker::Impl::track(FrameContext& ctx) {
   ctx.pose.reprojection_rms_px = solution->reprojection_rms_px;
   ctx.pose.ambiguous = solution->ambiguous;
   ctx.pose.tags_used = solution->tags_used;
-  previous_pose = solution->T_cam_world;
-  if (measured_newer && time_ns > measured_newer->time_ns) {
-    measured_older = measured_newer;
-  } else {
-    measured_older.reset();  // times out of order: no velocity from these two
-  }
-  measured_newer = TimedPose{time_ns, solution->T_cam_world};
-  frames_since_measured = 0;
+  measured(solution->T_cam_world, time_ns);
+  remember_still(ctx, pixels, stride);
   log::debug("track: frame {}: {} tags, rms {:.3f} px{}{}", ctx.input_index, solution->tags_used,
              solution->reprojection_rms_px, solution->ambiguous ? ", ambiguous" : "",
              searched ? ", found near the prediction" : "");

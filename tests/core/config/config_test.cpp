@@ -87,7 +87,7 @@ TEST(Config, DefaultTomlReadsBackAsTheDefaultConfigAndListsEveryKey) {
   for (const char* line :
        {"[source]", "type = ", "path = ", "pacing = ", "loop = ", "timestamp_offset_ns = ", "camera_model = ",
         "[track]", "enabled = ", "family = ", "quad_decimate = ", "quad_sigma = ", "threads = ", "max_hamming = ",
-        "min_decision_margin = ", "ambiguity_ratio = ", "max_predicted_frames = ", "search_window = ", "[[track.bundle]]", "id = ", "size_m = ", "center_m = ",
+        "min_decision_margin = ", "ambiguity_ratio = ", "max_predicted_frames = ", "search_window = ", "still_px = ", "[[track.bundle]]", "id = ", "size_m = ", "center_m = ",
         "yaw_deg = ", "[motion]", "latency_frames = ", "default_exposure_ms = ", "[render]", "light_direction = ", "light_color = ", "ambient = ", "msaa_samples = ",
         "egl_platform = ", "lens = ", "lens_canvas_scale = ", "rolling_shutter = ", "max_predicted_uncertainty_deg = ", "reuse_layer = ", "full_canvas = ", "occluder_lod_px = ", "ground_albedo = ", "bake_catcher = ", "[render.blur]", "method = ", "samples = ",
         "min_motion_px = ", "[pipeline]", "queue_depth = ", "max_frames = ", "log_level = ", "overlap_first_stage = "})
