@@ -72,6 +72,7 @@ void validate(const Config& config, const TagDetector& detector) {
 struct ProjectedBundle {
   double x0 = 1e18, y0 = 1e18, x1 = -1e18, y1 = -1e18;
   int tags_in_frame = 0;
+  double largest_tag_px = 0;  // the widest or tallest single tag's box
 };
 
 std::optional<ProjectedBundle> project_bundle(const CameraModel& camera, const SE3& T_cam_world,
@@ -79,16 +80,19 @@ std::optional<ProjectedBundle> project_bundle(const CameraModel& camera, const S
   ProjectedBundle bundle;
   for (const auto& [id, corners] : world_corners) {
     bool inside = true;
+    double tx0 = 1e18, ty0 = 1e18, tx1 = -1e18, ty1 = -1e18;
     for (const Vec3& corner : corners) {
       const auto pixel = camera.project(T_cam_world * corner);
       if (!pixel) return std::nullopt;
       const double x = (*pixel)[0], y = (*pixel)[1];
-      bundle.x0 = std::min(bundle.x0, x);
-      bundle.y0 = std::min(bundle.y0, y);
-      bundle.x1 = std::max(bundle.x1, x);
-      bundle.y1 = std::max(bundle.y1, y);
+      tx0 = std::min(tx0, x), ty0 = std::min(ty0, y), tx1 = std::max(tx1, x), ty1 = std::max(ty1, y);
       inside = inside && x >= 0 && y >= 0 && x <= camera.width() - 1 && y <= camera.height() - 1;
     }
+    bundle.x0 = std::min(bundle.x0, tx0);
+    bundle.y0 = std::min(bundle.y0, ty0);
+    bundle.x1 = std::max(bundle.x1, tx1);
+    bundle.y1 = std::max(bundle.y1, ty1);
+    bundle.largest_tag_px = std::max({bundle.largest_tag_px, tx1 - tx0, ty1 - ty0});
     bundle.tags_in_frame += inside ? 1 : 0;
   }
   return bundle;
@@ -296,9 +300,10 @@ std::optional<SearchWindow> TagTracker::Impl::search_window_at(const FrameContex
   const Frame& frame = ctx.camera;
   const auto box = project_bundle(*ctx.camera_model, expected, world_corners_by_id);
   if (!box || box->tags_in_frame == 0) return std::nullopt;
-  // The same margin as the search near a prediction: it holds the constant-velocity prediction's
-  // error on the blur captures' fastest turns, and libapriltag's own 3x3-tile neighbourhood.
-  const double margin = std::max(40.0, 0.5 * std::max(box->x1 - box->x0, box->y1 - box->y0));
+  // Half the largest tag and at least 40 px: it holds the constant-velocity prediction's error on
+  // the blur captures' fastest turns, and libapriltag's own 3x3-tile neighbourhood. (Not half the
+  // whole bundle's box, which for tags spread apart would make the window most of the frame.)
+  const double margin = std::max(40.0, 0.5 * box->largest_tag_px);
   const PixelRect rect = grown_rect(*box, margin, tile_grid_px(config.quad_decimate), frame.width, frame.height);
   // A window of most of the frame saves little and may cut a tag the prediction misplaced.
   if (rect.width < 16 || rect.height < 16 || double(rect.width) * rect.height > 0.5 * frame.width * frame.height)
