@@ -12,6 +12,7 @@
 #include "capture/recording/recording_reader.h"
 #include "core/track/tag_tracker.h"
 #include "tests/track/simulated_capture.h"
+#include "tests/track/tracked_capture.h"
 #include "tests/track/tracking_config.h"
 
 namespace arpipe {
@@ -26,17 +27,7 @@ const fs::path kDefaultCapture = fs::path(ARPIPE_BINARY_DIR) / "default-capture"
 std::vector<FrameContext> track_all(const RecordingReader& reader, bool search_window) {
   Config config = test::tracking_config();
   config.track.search_window = search_window;
-  TagTracker tracker;
-  tracker.configure(config);
-  const auto camera = std::make_shared<CameraModel>(reader.camera_model());
-  std::vector<FrameContext> frames(reader.frame_count());
-  for (size_t i = 0; i < frames.size(); ++i) {
-    reader.read(i, frames[i].camera);
-    frames[i].camera_model = camera;
-    frames[i].input_index = i;
-    tracker.process(frames[i]);
-  }
-  return frames;
+  return test::tracked_capture(reader, config);
 }
 
 // The whole default capture (a moving camera, a fast turn away, frames without the tag): the same

@@ -13,6 +13,7 @@
 #include "capture/recording/recording_reader.h"
 #include "core/track/tag_tracker.h"
 #include "tests/track/simulated_capture.h"
+#include "tests/track/tracked_capture.h"
 #include "tests/track/tracking_config.h"
 
 namespace arpipe {
@@ -28,18 +29,7 @@ const fs::path kDefaultCapture = fs::path(ARPIPE_BINARY_DIR) / "default-capture"
 std::vector<FrameContext> track_all(const RecordingReader& reader, double still_px, size_t frames = 0) {
   Config config = test::tracking_config();
   config.track.still_px = still_px;
-  TagTracker tracker;
-  tracker.configure(config);
-  const auto camera = std::make_shared<CameraModel>(reader.camera_model());
-  std::vector<FrameContext> out(frames ? frames : reader.frame_count());
-  for (size_t i = 0; i < out.size(); ++i) {
-    reader.read(i % reader.frame_count(), out[i].camera);
-    out[i].camera.meta.exposure_start_ns += int64_t(i / reader.frame_count()) * 1'000'000'000;  // looped, later
-    out[i].camera_model = camera;
-    out[i].input_index = i;
-    tracker.process(out[i]);
-  }
-  return out;
+  return test::tracked_capture(reader, config, frames);
 }
 
 // The still capture: 10 frames of one pose, fresh sensor noise in each, looped three times.
