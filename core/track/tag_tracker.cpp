@@ -340,6 +340,7 @@ bool TagTracker::Impl::keep_still_pose(FrameContext& ctx, const std::optional<SE
     return false;
   ctx.pose = still->pose;
   ctx.pose.image_still = true;
+  ctx.pose.searched_window_only = false;  // nothing was searched
   measured(ctx.pose.T_cam_world, time_ns);
   log::debug("track: frame {}: still ({:.3f} px since the last detection)", ctx.input_index, motion->max_corner_px);
   return true;

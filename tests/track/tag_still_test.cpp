@@ -44,6 +44,7 @@ TEST(TagStill, AStillCameraKeepsTheFirstDetectionsPose) {
     const PoseEstimate& pose = frames[i].pose;
     ASSERT_EQ(pose.state, TrackState::Tracking) << "frame " << i;
     EXPECT_TRUE(pose.image_still) << "frame " << i;
+    EXPECT_FALSE(pose.searched_window_only) << "frame " << i;
     // The very pose of the detection it kept, bit for bit, and its tags.
     EXPECT_EQ(pose.T_cam_world.translation(), frames[0].pose.T_cam_world.translation()) << "frame " << i;
     ASSERT_EQ(pose.tags.size(), frames[0].pose.tags.size());
