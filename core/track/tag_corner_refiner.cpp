@@ -135,7 +135,7 @@ TagCornerRefiner::TagCornerRefiner(PixelFormat grey_encoding) {
 }
 
 bool TagCornerRefiner::refine(const uint8_t* grey, int width, int height, size_t stride, const CameraModel& camera,
-                              int border_cells, std::array<Vec2, 4>& corners) const {
+                              int border_cells, std::array<Vec2, 4>& corners, std::array<Vec2, 4>* normalized) const {
   if (!grey || width < 2 || height < 2 || border_cells <= 0) return false;
   const LinearImage image(grey, width, height, stride, linear_);
 
@@ -166,10 +166,11 @@ bool TagCornerRefiner::refine(const uint8_t* grey, int width, int height, size_t
     edges[k] = *line;
   }
 
-  std::array<Vec2, 4> refined;
+  std::array<Vec2, 4> refined, undistorted;
   for (size_t k = 0; k < 4; ++k) {
     const auto corner = intersect(edges[(k + 3) % 4], edges[k]);
     if (!corner) return false;
+    undistorted[k] = *corner;
     const auto pixel = camera.project(Vec3{(*corner)[0], (*corner)[1], 1.0});
     if (!pixel || norm(Vec2{(*pixel)[0] - corners[k][0], (*pixel)[1] - corners[k][1]}) > kMaxCornerShiftPx) {
       return false;
@@ -177,6 +178,7 @@ bool TagCornerRefiner::refine(const uint8_t* grey, int width, int height, size_t
     refined[k] = *pixel;
   }
   corners = refined;
+  if (normalized) *normalized = undistorted;
   return true;
 }
 

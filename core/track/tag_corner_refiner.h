@@ -25,8 +25,10 @@ class TagCornerRefiner {
   // border_cells: how many code cells the detected square spans (family width_at_border), which
   // bounds how far from an edge one may sample without leaving the border. Returns false, leaving
   // corners untouched, when the tag is too small or an edge cannot be located.
+  // normalized, when given, receives the refined corners undistorted (x/z, y/z): the intersections
+  // the pixels were projected from.
   bool refine(const uint8_t* grey, int width, int height, size_t stride, const CameraModel& camera,
-              int border_cells, std::array<Vec2, 4>& corners) const;
+              int border_cells, std::array<Vec2, 4>& corners, std::array<Vec2, 4>* normalized = nullptr) const;
 
  private:
   std::array<float, 256> linear_{};

@@ -105,8 +105,8 @@ std::optional<TagPoseSolution> solve(const CameraModel& camera, const std::vecto
     UndistortedTag undistorted{&tag, {}, 0};
     bool ok = true;
     for (size_t c = 0; c < 4 && ok; ++c) {
-      const auto n = camera.normalize(tag.pixels[c]);
-      ok = n.has_value();
+      const auto n = tag.normalized ? std::optional<Vec2>((*tag.normalized)[c]) : camera.normalize(tag.pixels[c]);
+      ok = n.has_value() && std::isfinite((*n)[0]) && std::isfinite((*n)[1]);
       if (ok) undistorted.normalized[c] = {(*n)[0], (*n)[1]};
     }
     if (!ok) continue;

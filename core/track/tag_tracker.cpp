@@ -255,18 +255,22 @@ void TagTracker::Impl::collect(FrameContext& ctx, const uint8_t* pixels, size_t 
                         observation.decision_margin >= config.min_decision_margin;
     // Only tags that count are refined (it costs a few hundred unprojections); the others keep
     // libapriltag's corners. A tag too small to refine keeps them as well.
+    std::optional<std::array<Vec2, 4>> normalized;
     if (usable && config.refine_corners) {
-      refiner.refine(pixels, frame.width, frame.height, stride, *ctx.camera_model, detector->border_cells(),
-                     observation.corners);
+      std::array<Vec2, 4> undistorted;
+      if (refiner.refine(pixels, frame.width, frame.height, stride, *ctx.camera_model, detector->border_cells(),
+                         observation.corners, &undistorted))
+        normalized = undistorted;
     }
     ctx.pose.tags.push_back(observation);
     if (!usable) continue;
     const auto [slot, inserted] = correspondence_by_id.emplace(observation.id, correspondences.size());
     if (inserted) {
-      correspondences.push_back({world->second, observation.corners});
+      correspondences.push_back({world->second, observation.corners, normalized});
       correspondence_margins.push_back(observation.decision_margin);
     } else if (observation.decision_margin > correspondence_margins[slot->second]) {
       correspondences[slot->second].pixels = observation.corners;
+      correspondences[slot->second].normalized = normalized;
       correspondence_margins[slot->second] = observation.decision_margin;
     }
   }

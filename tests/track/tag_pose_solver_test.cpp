@@ -84,6 +84,32 @@ TEST_P(ExactCorners, RecoverThePoseThatProjectedThem) {
   }
 }
 
+// Corners handed over undistorted (as the corner refiner has them) are used as they are: the same
+// pose as unprojecting their pixels, to mrcal's unprojection error (1e-8 px over ~500 px of focal
+// length).
+TEST(SolveTagPose, CornersGivenUndistortedSolveLikeTheirPixels) {
+  const CameraModel camera = test::opencv8_640x480();
+  const auto bundle = test::four_tag_bundle();
+  test::ViewRange range;
+  range.min_distance = 0.35;
+  std::mt19937_64 rng(7);
+  for (int trial = 0; trial < 20; ++trial) {
+    const SE3 truth = test::random_view(camera, bundle, range, rng);
+    auto tags = test::project_bundle(camera, truth, bundle, 0.3, rng);
+    ASSERT_TRUE(tags);
+    const auto from_pixels = solve_tag_pose(camera, *tags, 3.0, std::nullopt);
+    for (TagCorrespondence& tag : *tags) {
+      std::array<Vec2, 4> undistorted;
+      for (size_t c = 0; c < 4; ++c) undistorted[c] = *camera.normalize(tag.pixels[c]);
+      tag.normalized = undistorted;
+    }
+    const auto from_normalized = solve_tag_pose(camera, *tags, 3.0, std::nullopt);
+    ASSERT_TRUE(from_pixels && from_normalized) << "trial " << trial;
+    EXPECT_LT(norm(from_pixels->T_cam_world.translation() - from_normalized->T_cam_world.translation()), 1e-9);
+    EXPECT_LT(rotation_angle_between(from_pixels->T_cam_world, from_normalized->T_cam_world), 1e-9);
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(
     Cases, ExactCorners,
     ::testing::Values(ExactCase{"SingleTagPinhole", test::pinhole_640x480, single_tag, 0.2},
