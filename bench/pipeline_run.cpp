@@ -1,15 +1,65 @@
 // What the pipeline benchmarks share (see pipeline_run.h).
 #include "bench/pipeline_run.h"
 
+#include <chrono>
+#include <memory>
+#include <vector>
+
 #include "apps/common/pipeline_assembly.h"
+#include "core/pipeline/frame_sink.h"
 
 namespace arpipe {
+namespace {
 
-PipelineMetrics run_pipeline(const Config& config) {
-  PipelineRunner runner(make_source(config), make_stage_factory(), {}, config);
+// Counts what the stages recorded on each frame after the warm-up, as the runner's own metrics do
+// for every frame. Runs on the sink thread; read after the runner has finished.
+class SteadyStateSink final : public FrameSink {
+ public:
+  explicit SteadyStateSink(std::shared_ptr<PipelineMetrics> metrics) : metrics_(std::move(metrics)) {}
+  std::string describe() const override { return "bench: steady state"; }
+  void consume(const FrameContext& ctx) noexcept override {
+    const auto now = std::chrono::steady_clock::now();
+    if (++seen_ <= kWarmupFrames) {
+      since_ = now;
+      return;
+    }
+    PipelineMetrics& m = *metrics_;
+    ++m.frames_out;
+    m.wall_seconds = std::chrono::duration<double>(now - since_).count();
+    for (const StageTiming& t : ctx.timings) {
+      StageStats& stats = m.stages[t.stage];
+      ++stats.runs;
+      stats.total_ms += t.ms;
+      if (!t.skipped.empty()) ++stats.skips[t.skipped];
+    }
+    if (ctx.pose.state == TrackState::Tracking) ++m.frames_tracked;
+    if (ctx.pose.state == TrackState::Tracking && ctx.pose.searched_window_only) ++m.frames_tracked_in_window;
+    if (ctx.pose.state == TrackState::Tracking && ctx.pose.image_still) ++m.frames_still;
+    if (ctx.pose.state == TrackState::Predicted) ++m.frames_predicted;
+    if (ctx.pose.state == TrackState::Lost) ++m.frames_lost;
+  }
+
+ private:
+  std::shared_ptr<PipelineMetrics> metrics_;
+  int64_t seen_ = 0;
+  std::chrono::steady_clock::time_point since_;
+};
+
+}  // namespace
+
+PipelineMetrics run_pipeline(Config config) {
+  config.pipeline.max_frames += kWarmupFrames;
+  auto metrics = std::make_shared<PipelineMetrics>();
+  std::vector<std::unique_ptr<FrameSink>> sinks;
+  sinks.push_back(std::make_unique<SteadyStateSink>(metrics));
+  PipelineRunner runner(make_source(config), make_stage_factory(), std::move(sinks), config);
   runner.start();
   runner.wait();
-  return runner.metrics();
+  const PipelineMetrics all = runner.metrics();
+  PipelineMetrics measured = *metrics;
+  measured.frames_in = all.frames_in;
+  measured.queue_drops = all.queue_drops;
+  return measured;
 }
 
 double mean_stage_ms(const PipelineMetrics& metrics, const std::string& stage) {

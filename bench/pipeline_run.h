@@ -1,7 +1,8 @@
 // What the pipeline benchmarks share: one replay of a config through the whole pipeline without
-// sinks, and a stage's mean time from its metrics.
+// sinks, measured in its steady state, and a stage's mean time from its metrics.
 #pragma once
 
+#include <cstdint>
 #include <string>
 
 #include "core/config/config.h"
@@ -9,8 +10,15 @@
 
 namespace arpipe {
 
-// Runs the config's source through every stage to its end (no sinks) and returns the metrics.
-PipelineMetrics run_pipeline(const Config& config);
+// The first frames of a run pay for its setup (the EGL context, the lens map, the first render
+// targets, the threads' start): once per run, not per frame, so they are left out.
+constexpr int64_t kWarmupFrames = 10;
+
+// Runs the config's source through every stage (no sinks) for kWarmupFrames frames more than its
+// pipeline.max_frames, and returns the metrics of the frames after those: frames_out, the stages'
+// times and skips, the tracking counts, and wall_seconds from the last warm-up frame's hand-over
+// to the last frame's.
+PipelineMetrics run_pipeline(Config config);
 // Mean ms per frame of a stage, skipped frames included; 0 when it never ran.
 double mean_stage_ms(const PipelineMetrics& metrics, const std::string& stage);
 

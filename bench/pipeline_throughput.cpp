@@ -71,9 +71,11 @@ int run_pipeline_benchmark(const PipelineOptions& options) {
   uname(&u);
   // Parsed once up front, so that a bad config or --set fails before any measuring.
   const Config config = bench_config(options, options.frames);
-  fmt::print("config {}{}, capture {}, {} frames per run; {} {}, {} hardware threads; {}\n\n", options.config,
+  fmt::print("config {}{}, capture {}, {} frames per run after {} warm-up frames; {} {}, {} hardware threads; {}\n\n",
+             options.config,
              options.overrides.empty() ? "" : " with --set " + fmt::format("{}", fmt::join(options.overrides, " ")),
-             config.source.path.string(), options.frames, u.sysname, u.machine, std::thread::hardware_concurrency(),
+             config.source.path.string(), options.frames, kWarmupFrames, u.sysname, u.machine,
+             std::thread::hardware_concurrency(),
              fmt::format("{:%Y-%m-%d %H:%M} UTC", fmt::gmtime(std::time(nullptr))));
   std::string header = "| run | frames | frames/s |", rule = "|---|---:|---:|";
   for (const std::string& stage : kStages) {
