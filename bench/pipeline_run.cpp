@@ -19,6 +19,7 @@ class SteadyStateSink final : public FrameSink {
   std::string describe() const override { return "bench: steady state"; }
   void consume(const FrameContext& ctx) noexcept override {
     const auto now = std::chrono::steady_clock::now();
+    if (seen_ == 0) first_ = now;
     if (++seen_ <= kWarmupFrames) {
       since_ = now;
       return;
@@ -39,22 +40,30 @@ class SteadyStateSink final : public FrameSink {
     if (ctx.pose.state == TrackState::Lost) ++m.frames_lost;
   }
 
+  std::chrono::steady_clock::time_point first_frame() const { return first_; }
+  bool saw_a_frame() const { return seen_ > 0; }
+
  private:
   std::shared_ptr<PipelineMetrics> metrics_;
   int64_t seen_ = 0;
-  std::chrono::steady_clock::time_point since_;
+  std::chrono::steady_clock::time_point first_, since_;
 };
 
 }  // namespace
 
-PipelineMetrics run_pipeline(Config config) {
+PipelineMetrics run_pipeline(Config config, double* setup_seconds) {
   config.pipeline.max_frames += kWarmupFrames;
   auto metrics = std::make_shared<PipelineMetrics>();
   std::vector<std::unique_ptr<FrameSink>> sinks;
-  sinks.push_back(std::make_unique<SteadyStateSink>(metrics));
+  auto sink = std::make_unique<SteadyStateSink>(metrics);
+  const SteadyStateSink& steady = *sink;  // owned by the runner, which outlives this use
+  sinks.push_back(std::move(sink));
+  const auto built = std::chrono::steady_clock::now();
   PipelineRunner runner(make_source(config), make_stage_factory(), std::move(sinks), config);
   runner.start();
   runner.wait();
+  if (setup_seconds)
+    *setup_seconds = steady.saw_a_frame() ? std::chrono::duration<double>(steady.first_frame() - built).count() : 0;
   const PipelineMetrics all = runner.metrics();
   PipelineMetrics measured = *metrics;
   measured.frames_in = all.frames_in;

@@ -17,8 +17,9 @@ constexpr int64_t kWarmupFrames = 10;
 // Runs the config's source through every stage (no sinks) for kWarmupFrames frames more than its
 // pipeline.max_frames, and returns the metrics of the frames after those: frames_out, the stages'
 // times and skips, the tracking counts, and wall_seconds from the last warm-up frame's hand-over
-// to the last frame's.
-PipelineMetrics run_pipeline(Config config);
+// to the last frame's. setup_seconds, when given, receives the time from building the pipeline to
+// the first frame's hand-over: what a start costs before the first picture.
+PipelineMetrics run_pipeline(Config config, double* setup_seconds = nullptr);
 // Mean ms per frame of a stage, skipped frames included; 0 when it never ran.
 double mean_stage_ms(const PipelineMetrics& metrics, const std::string& stage);
 
