@@ -9,6 +9,7 @@
 #include <opencv2/core.hpp>
 
 #include "core/log.h"
+#include "core/track/pose_refinement.h"
 
 namespace arpipe {
 namespace {
@@ -27,13 +28,6 @@ struct UndistortedTag {
 SE3 se3_from_cv(const cv::Mat& rvec, const cv::Mat& tvec) {
   return SE3::from_rt({rvec.at<double>(0), rvec.at<double>(1), rvec.at<double>(2)},
                       {tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2)});
-}
-
-void se3_to_cv(const SE3& pose, cv::Mat& rvec, cv::Mat& tvec) {
-  const Vec3 r = pose.rotation_vector();
-  const Vec3& t = pose.translation();
-  rvec = (cv::Mat_<double>(3, 1) << r[0], r[1], r[2]);
-  tvec = (cv::Mat_<double>(3, 1) << t[0], t[1], t[2]);
 }
 
 // T_world_tag of a square from its world corners (BL, BR, TR, TL), in the tag frame of docs/DESIGN.md,
@@ -134,13 +128,17 @@ std::optional<TagPoseSolution> solve(const CameraModel& camera, const std::vecto
     if (!seeds.empty()) break;
   }
 
+  std::vector<Vec3> world_points;
+  std::vector<Vec2> image_points;
+  for (size_t i = 0; i < object.size(); ++i) {
+    world_points.push_back({object[i].x, object[i].y, object[i].z});
+    image_points.push_back({image[i].x, image[i].y});
+  }
   std::vector<PoseCandidate> candidates;
-  const cv::TermCriteria criteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 100, 1e-14);
   for (const SE3& seed : seeds) {
-    cv::Mat rvec, tvec;
-    se3_to_cv(seed, rvec, tvec);
-    cv::solvePnPRefineLM(object, image, cv::Mat::eye(3, 3, CV_64F), cv::noArray(), rvec, tvec, criteria);
-    const SE3 refined = se3_from_cv(rvec, tvec);
+    const std::optional<SE3> minimum = refine_pose(seed, world_points, image_points);
+    if (!minimum) continue;
+    const SE3& refined = *minimum;
     const double error = reprojection_rms_px(camera, refined, usable);
     if (!std::isfinite(error)) continue;
     const auto duplicate = std::find_if(candidates.begin(), candidates.end(), [&](const PoseCandidate& c) {
