@@ -651,9 +651,12 @@ TEST(PipelineRunner, UnhealthyWhileAStageIsStuckHealthyWhenIdle) {
     release->changed.notify_all();
   }
   h.wait_until_sink_has(0, 1);
-  // The sink's own thread has left consume() (frames_out counts frames handed to the sinks).
-  while (h.runner->status().sinks[0].consumed < 1) std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  // Both threads now wait for a frame the source does not have: idle is healthy, even with a
+  // The sink's own thread has left consume(), and the thread that hands frames to the sinks has
+  // counted the frame out, which it does only once it is no longer busy with it (a sink may
+  // consume the frame before that thread has finished handing it over).
+  while (h.runner->status().sinks[0].consumed < 1 || h.runner->metrics().frames_out < 1)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  // Every thread now waits for a frame the source does not have: idle is healthy, even with a
   // threshold of 1 ns.
   EXPECT_TRUE(h.runner->healthy(1));
 
