@@ -24,6 +24,7 @@
 #include "capture/sim/simulator.h"
 #include "core/motion/motion_stage.h"
 #include "core/track/tag_tracker.h"
+#include "tests/track/tracked_capture.h"
 #include "tests/track/tracking_config.h"
 #include "tests/track/simulated_capture.h"
 
@@ -119,18 +120,9 @@ struct TagPanRun {
 
 TagPanRun run_tag_pan(const fs::path& dir) {
   const RecordingReader reader(dir);
-  const auto camera = std::make_shared<CameraModel>(reader.camera_model());
   const auto& truth = reader.ground_truth();
   Config config = test::tracking_config();  // the default bundle: tag 0 of tag36h11, 10 cm, at the origin, as simulated
-  TagTracker tracker;
-  tracker.configure(config);
-  std::vector<FrameContext> frames(reader.frame_count());
-  for (size_t i = 0; i < frames.size(); ++i) {
-    reader.read(i, frames[i].camera);
-    frames[i].camera_model = camera;
-    frames[i].input_index = i;
-    tracker.process(frames[i]);
-  }
+  std::vector<FrameContext> frames = test::tracked_capture(reader, config);
   TagPanRun run;
   run.frames = int(frames.size());
   MotionStage stage0, stage1;
