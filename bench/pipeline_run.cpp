@@ -11,8 +11,8 @@
 namespace arpipe {
 namespace {
 
-// Counts what the stages recorded on each frame after the warm-up, as the runner's own metrics do
-// for every frame. Runs on the sink thread; read after the runner has finished.
+// Counts what the stages recorded on each frame after the warm-up (count_frame, as the runner does
+// for every frame). Runs on the sink thread; read after the runner has finished.
 class SteadyStateSink final : public FrameSink {
  public:
   explicit SteadyStateSink(std::shared_ptr<PipelineMetrics> metrics) : metrics_(std::move(metrics)) {}
@@ -27,17 +27,7 @@ class SteadyStateSink final : public FrameSink {
     PipelineMetrics& m = *metrics_;
     ++m.frames_out;
     m.wall_seconds = std::chrono::duration<double>(now - since_).count();
-    for (const StageTiming& t : ctx.timings) {
-      StageStats& stats = m.stages[t.stage];
-      ++stats.runs;
-      stats.total_ms += t.ms;
-      if (!t.skipped.empty()) ++stats.skips[t.skipped];
-    }
-    if (ctx.pose.state == TrackState::Tracking) ++m.frames_tracked;
-    if (ctx.pose.state == TrackState::Tracking && ctx.pose.searched_window_only) ++m.frames_tracked_in_window;
-    if (ctx.pose.state == TrackState::Tracking && ctx.pose.image_still) ++m.frames_still;
-    if (ctx.pose.state == TrackState::Predicted) ++m.frames_predicted;
-    if (ctx.pose.state == TrackState::Lost) ++m.frames_lost;
+    count_frame(m, ctx);
   }
 
   std::chrono::steady_clock::time_point first_frame() const { return first_; }

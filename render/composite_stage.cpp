@@ -121,7 +121,7 @@ void CompositeStage::read_layer(const VirtualLayerTexture& layer, const PixelRec
     // GL_SRGB8_ALPHA8: the bytes are the premultiplied colour sRGB-encoded, alpha linear.
     layer_bytes_.resize(values);
     glReadPixels(rect.x, rect.y, rect.width, rect.height, GL_RGBA, GL_UNSIGNED_BYTE, layer_bytes_.data());
-    const CameraResponse srgb = CameraResponse::srgb();
+    static const CameraResponse srgb = CameraResponse::srgb();
     for (size_t i = 0; i < values; ++i)
       layer_pixels_[i] = i % 4 == 3 ? layer_bytes_[i] / 255.0f : srgb.decode8(layer_bytes_[i]);
   }

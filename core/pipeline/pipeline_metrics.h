@@ -40,4 +40,8 @@ struct PipelineMetrics {
   double fps() const { return wall_seconds > 0 ? frames_out / wall_seconds : 0; }
 };
 
+struct FrameContext;
+// Adds what one processed frame recorded: each stage's time and skip, and the tracking counts.
+void count_frame(PipelineMetrics& metrics, const FrameContext& ctx);
+
 }  // namespace arpipe

@@ -151,18 +151,7 @@ void PipelineRunner::finish_frame(FrameContext& ctx, size_t first_stage) {
   for (size_t i = first_stage; i < stages_.size(); ++i) stages_[i]->process(ctx);
   {
     std::lock_guard lock(metrics_mutex_);
-    for (const auto& t : ctx.timings) {
-      auto& stats = metrics_.stages[t.stage];
-      ++stats.runs;
-      stats.total_ms += t.ms;
-      stats.seconds.add(t.ms * 1e-3);
-      if (!t.skipped.empty()) ++stats.skips[t.skipped];
-    }
-    if (ctx.pose.state == TrackState::Tracking) ++metrics_.frames_tracked;
-    if (ctx.pose.state == TrackState::Tracking && ctx.pose.searched_window_only) ++metrics_.frames_tracked_in_window;
-    if (ctx.pose.state == TrackState::Tracking && ctx.pose.image_still) ++metrics_.frames_still;
-    if (ctx.pose.state == TrackState::Predicted) ++metrics_.frames_predicted;
-    if (ctx.pose.state == TrackState::Lost) ++metrics_.frames_lost;
+    count_frame(metrics_, ctx);
   }
   // Not busy once the stages are done: a push that waits for a slow sink is the sink's stall, and
   // the sink may take the frame before this thread runs again.

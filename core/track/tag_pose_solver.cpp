@@ -111,13 +111,12 @@ std::optional<TagPoseSolution> solve(const CameraModel& camera, const std::vecto
   std::sort(usable.begin(), usable.end(),
             [](const UndistortedTag& a, const UndistortedTag& b) { return a.image_area > b.image_area; });
 
-  std::vector<cv::Point3d> object;
-  std::vector<cv::Point2d> image;
+  std::vector<Vec3> world_points;
+  std::vector<Vec2> image_points;
   for (const auto& tag : usable) {
     for (size_t c = 0; c < 4; ++c) {
-      const Vec3& w = tag.tag->world[c];
-      object.emplace_back(w[0], w[1], w[2]);
-      image.push_back(tag.normalized[c]);
+      world_points.push_back(tag.tag->world[c]);
+      image_points.push_back({tag.normalized[c].x, tag.normalized[c].y});
     }
   }
 
@@ -128,12 +127,6 @@ std::optional<TagPoseSolution> solve(const CameraModel& camera, const std::vecto
     if (!seeds.empty()) break;
   }
 
-  std::vector<Vec3> world_points;
-  std::vector<Vec2> image_points;
-  for (size_t i = 0; i < object.size(); ++i) {
-    world_points.push_back({object[i].x, object[i].y, object[i].z});
-    image_points.push_back({image[i].x, image[i].y});
-  }
   std::vector<PoseCandidate> candidates;
   for (const SE3& seed : seeds) {
     const std::optional<SE3> minimum = refine_pose(seed, world_points, image_points);

@@ -149,6 +149,7 @@ struct TagTracker::Impl {
     PixelRect box;
     std::vector<uint8_t> luma;  // box.width x box.height
     PoseEstimate pose;
+    std::optional<std::array<double, 4>> bundle_box;  // x0, y0, x1, y1 of the bundle projected with pose
   };
   std::optional<StillReference> still;
   // The last two measured poses at their frames' mid-exposure (older first), and the frames since
@@ -323,9 +324,9 @@ bool TagTracker::Impl::keep_still_pose(FrameContext& ctx, const std::optional<SE
   // and then for the detection. (It must slow down first: a kept pose predicts no motion.)
   if (predicted) {
     const auto moved = project_bundle(*ctx.camera_model, *predicted, world_corners_by_id);
-    const auto kept = project_bundle(*ctx.camera_model, still->pose.T_cam_world, world_corners_by_id);
-    if (!moved || !kept || std::max({std::abs(moved->x0 - kept->x0), std::abs(moved->x1 - kept->x1),
-                                     std::abs(moved->y0 - kept->y0), std::abs(moved->y1 - kept->y1)}) > 0.5)
+    const auto& kept = still->bundle_box;
+    if (!moved || !kept || std::max({std::abs(moved->x0 - (*kept)[0]), std::abs(moved->y0 - (*kept)[1]),
+                                     std::abs(moved->x1 - (*kept)[2]), std::abs(moved->y1 - (*kept)[3])}) > 0.5)
       return false;
   }
   const PixelRect& box = still->box;
@@ -365,7 +366,9 @@ void TagTracker::Impl::remember_still(const FrameContext& ctx, const uint8_t* pi
   // A few pixels beyond the corners: the border's outer edges are in it, whichever way it moves.
   const PixelRect rect = grown_rect(box, 4.0, 1, frame.width, frame.height);
   if (rect.width < 16 || rect.height < 16) return;
-  StillReference reference{rect, std::vector<uint8_t>(size_t(rect.width) * size_t(rect.height)), ctx.pose};
+  StillReference reference{rect, std::vector<uint8_t>(size_t(rect.width) * size_t(rect.height)), ctx.pose, {}};
+  if (const auto kept = project_bundle(*ctx.camera_model, ctx.pose.T_cam_world, world_corners_by_id))
+    reference.bundle_box = std::array<double, 4>{kept->x0, kept->y0, kept->x1, kept->y1};
   for (int y = 0; y < rect.height; ++y)
     std::copy_n(pixels + size_t(rect.y + y) * stride + size_t(rect.x), size_t(rect.width),
                 reference.luma.data() + size_t(y) * size_t(rect.width));
