@@ -23,7 +23,6 @@ layout(location = 4) in float a_transfer2; // 8
 uniform mat3 u_world_from_object_rotation;  // without the scale
 uniform vec3 u_world_from_object_translation;
 uniform float u_object_scale;
-uniform bool u_prt;
 uniform vec3 u_prt_light[9];  // radiance SH in the object's frame
 out vec3 v_normal_world;
 out vec3 v_world;
@@ -32,12 +31,13 @@ out vec3 v_prt_radiance;      // the environment's outgoing radiance for albedo 
 void main() {
   gl_Position = camera_to_clip(pose_camera_point(a_position));
   // Seed 002: one dot product of light and transfer per vertex, interpolated (Gouraud).
-  v_prt_radiance = u_prt ? a_transfer0.x * u_prt_light[0] + a_transfer0.y * u_prt_light[1]
-                           + a_transfer0.z * u_prt_light[2] + a_transfer0.w * u_prt_light[3]
-                           + a_transfer1.x * u_prt_light[4] + a_transfer1.y * u_prt_light[5]
-                           + a_transfer1.z * u_prt_light[6] + a_transfer1.w * u_prt_light[7]
-                           + a_transfer2 * u_prt_light[8]
-                         : vec3(0.0);
+#if WITH_PRT
+  v_prt_radiance = a_transfer0.x * u_prt_light[0] + a_transfer0.y * u_prt_light[1] + a_transfer0.z * u_prt_light[2]
+                 + a_transfer0.w * u_prt_light[3] + a_transfer1.x * u_prt_light[4] + a_transfer1.y * u_prt_light[5]
+                 + a_transfer1.z * u_prt_light[6] + a_transfer1.w * u_prt_light[7] + a_transfer2 * u_prt_light[8];
+#else
+  v_prt_radiance = vec3(0.0);
+#endif
   // The camera's motion does not move the object in the world, so one normal and one world
   // position serve every row.
   v_normal_world = u_world_from_object_rotation * a_normal;
@@ -45,12 +45,15 @@ void main() {
 }
 )glsl";
 
+// The variant's branches are chosen by the preprocessor (ShadingVariant), not by uniforms: a
+// software rasteriser runs both sides of a uniform's branch for every pixel (llvmpipe masks
+// them), which cost the lone cube 1 ms a frame.
 constexpr std::string_view kShadingFragmentShaderTemplate = R"glsl(#version 300 es
+{defines}
 precision highp float;
 in vec3 v_normal_world;
 in vec3 v_world;
 in vec3 v_prt_radiance;
-uniform bool u_prt;
 uniform vec4 u_base_color;       // linear, straight alpha
 uniform vec3 u_light_direction;  // world frame, unit, towards the light
 uniform vec4 u_light_position;   // w = 1: a lamp there (the direction is per point)
@@ -61,7 +64,6 @@ uniform vec3 u_radiance_sh[9];   // the environment's radiance (world), for the 
 uniform float u_specular;        // its weight
 uniform vec3 u_camera_world;     // the eye, for the reflection direction
 uniform float u_exposure_scale;
-uniform bool u_shadow_catcher;
 out vec4 out_color;              // linear, premultiplied alpha
 {shadow_lookup}
 {real_shadow_lookup}
@@ -111,38 +113,42 @@ void main() {{
   vec3 towards_light = u_light_position.w > 0.5 ? normalize(u_light_position.xyz - v_world) : u_light_direction;
   float lambert = max(dot(normal, towards_light), 0.0);
   float visibility = shadow_visibility(v_world);  // uniform control flow: it takes derivatives
+#if SHADOW_CATCHER
+  // Differential rendering: the real surface's light with the virtual shadow over its light
+  // without it, where the real casters already shade it as they do in the picture. One ratio
+  // for all channels (the layer has one alpha), by luminance.
   // The real casters' own map: compiled in only when proxies cast (else a constant 1), since a
   // uniform's branch would still cost the lookup on a software rasteriser.
   float real_visibility = real_shadow_visibility(v_world);
-  if (u_shadow_catcher) {{
-    // Differential rendering: the real surface's light with the virtual shadow over its light
-    // without it, where the real casters already shade it as they do in the picture. One ratio
-    // for all channels (the layer has one alpha), by luminance.
-    const vec3 luma = vec3(0.2126, 0.7152, 0.0722);
-    float ambient = max(dot(real_ambient_at(normal), luma), 0.0);
-    float direct = dot(u_light_color, luma) * lambert;
-    float real_direct = direct * real_visibility;
-    float occlusion = sky_occlusion(v_world, normal, ambient);
-    if (u_ground_catcher) {{
-      // Faded out over the last tenth of the square's half-width, so that its edge shows no step.
-      vec2 inside = min(v_world.xy - u_catcher_patch.xy, u_catcher_patch.zw - v_world.xy);
-      float fade_width = 0.1 * max(0.5 * (u_catcher_patch.z - u_catcher_patch.x), 1e-6);
-      occlusion *= clamp(min(inside.x, inside.y) / fade_width, 0.0, 1.0);
-    }}
-    float lit = ambient * (1.0 - occlusion) + visibility * direct;
-    float ratio = ambient + real_direct > 0.0 ? min(lit / (ambient + real_direct), 1.0) : 1.0;
-    out_color = vec4(0.0, 0.0, 0.0, 1.0 - ratio);
-    return;
+  const vec3 luma = vec3(0.2126, 0.7152, 0.0722);
+  float ambient = max(dot(real_ambient_at(normal), luma), 0.0);
+  float direct = dot(u_light_color, luma) * lambert;
+  float real_direct = direct * real_visibility;
+  float occlusion = sky_occlusion(v_world, normal, ambient);
+  if (u_ground_catcher) {{
+    // Faded out over the last tenth of the square's half-width, so that its edge shows no step.
+    vec2 inside = min(v_world.xy - u_catcher_patch.xy, u_catcher_patch.zw - v_world.xy);
+    float fade_width = 0.1 * max(0.5 * (u_catcher_patch.z - u_catcher_patch.x), 1e-6);
+    occlusion *= clamp(min(inside.x, inside.y) / fade_width, 0.0, 1.0);
   }}
-  vec3 environment = u_prt ? v_prt_radiance : ambient_at(normal);
+  float lit = ambient * (1.0 - occlusion) + visibility * direct;
+  float ratio = ambient + real_direct > 0.0 ? min(lit / (ambient + real_direct), 1.0) : 1.0;
+  out_color = vec4(0.0, 0.0, 0.0, 1.0 - ratio);
+#else
+#if WITH_PRT
+  vec3 environment = v_prt_radiance;
+#else
+  vec3 environment = ambient_at(normal);
+#endif
   vec3 rgb = u_base_color.rgb * max(environment + u_light_color * (lambert * visibility), 0.0);
-  if (u_specular > 0.0) {{
-    // Seed 002's reflection mapping, from the band-limited environment: a glossy, not a mirror, look.
-    vec3 reflected = reflect(normalize(v_world - u_camera_world), normal);
-    rgb += u_specular * max(sh9_at(u_radiance_sh, reflected), 0.0);
-  }}
+#if WITH_SPECULAR
+  // Seed 002's reflection mapping, from the band-limited environment: a glossy, not a mirror, look.
+  vec3 reflected = reflect(normalize(v_world - u_camera_world), normal);
+  rgb += u_specular * max(sh9_at(u_radiance_sh, reflected), 0.0);
+#endif
   rgb *= u_exposure_scale;
   out_color = vec4(rgb * u_base_color.a, u_base_color.a);
+#endif
 }}
 )glsl";
 
@@ -162,7 +168,7 @@ void main() { out_color = vec4(0.0); }
 // The ground catcher's ratio baked over its square (render/shadow/catcher_bake.h): the shading
 // program's fragment shader, its point placed on the bake texture instead of the camera image,
 // so each texel holds what the catcher would draw at that ground point.
-constexpr std::string_view kCatcherBakeVertexShader = R"glsl(#version 300 es
+constexpr std::string_view kCatcherBakeVertexShader = R"glsl(
 precision highp float;
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
@@ -261,8 +267,9 @@ void set_vec3(GLint location, const Vec3& v) {
   glUniform3f(location, static_cast<float>(v[0]), static_cast<float>(v[1]), static_cast<float>(v[2]));
 }
 
-std::string vertex_source(std::initializer_list<std::string_view> tables, std::string_view body) {
-  std::string source = fmt::format("#version 300 es\nprecision highp float;\n{}\n", lens_projection_glsl());
+std::string vertex_source(std::initializer_list<std::string_view> tables, std::string_view body,
+                          std::string_view defines = {}) {
+  std::string source = fmt::format("#version 300 es\n{}\nprecision highp float;\n{}\n", defines, lens_projection_glsl());
   bool first = true;
   for (std::string_view table : tables) {
     source += row_poses_glsl(table, first);
@@ -291,44 +298,59 @@ ObjectRenderer::ObjectRenderer()
   prepare(ShadowMethod::Off);
 }
 
-void ObjectRenderer::prepare(ShadowMethod method) { shading(method, false); }
+void ObjectRenderer::prepare(ShadowMethod method) {
+  shading({ShadowMethod::Off, false, false, false, false});  // a surface no shadow reaches
+  if (method != ShadowMethod::Off) shading({method, false, true, false, false});  // the ground catcher
+}
 
 namespace {
 
-std::string shading_fragment_source(ShadowMethod method, bool real_shadow) {
-  return fmt::format(fmt::runtime(kShadingFragmentShaderTemplate), fmt::arg("shadow_lookup", shadow_lookup_glsl(method)),
-                     fmt::arg("real_shadow_lookup", shadow_lookup_glsl(real_shadow ? method : ShadowMethod::Off, "real_")),
+std::string variant_defines(const ShadingVariant& variant) {
+  return fmt::format("#define SHADOW_CATCHER {:d}\n#define WITH_PRT {:d}\n#define WITH_SPECULAR {:d}", variant.catcher,
+                     variant.prt, variant.specular);
+}
+
+std::string shading_fragment_source(const ShadingVariant& variant) {
+  return fmt::format(fmt::runtime(kShadingFragmentShaderTemplate), fmt::arg("defines", variant_defines(variant)),
+                     fmt::arg("shadow_lookup", shadow_lookup_glsl(variant.method)),
+                     fmt::arg("real_shadow_lookup",
+                              shadow_lookup_glsl(variant.real_shadow ? variant.method : ShadowMethod::Off, "real_")),
                      fmt::arg("max_sky_occluders", Lighting::kMaxSkyOccluders));
 }
 
-std::string shading_program_name(std::string_view what, ShadowMethod method, bool real_shadow) {
-  return fmt::format("{} ({} shadows{})", what, shadow_method_name(method), real_shadow ? ", real casters" : "");
+std::string shading_program_name(std::string_view what, const ShadingVariant& variant) {
+  return fmt::format("{} ({}; {} shadows{}{}{})", what, variant.catcher ? "shadow catcher" : "surface",
+                     shadow_method_name(variant.method), variant.real_shadow ? ", real casters" : "",
+                     variant.prt ? ", PRT" : "", variant.specular ? ", specular" : "");
 }
 
-// The program of `programs` for this lookup, compiled on first use with the shading fragment shader
-// and the vertex shader `vertex` makes.
-const GlProgram& program_for_lookup(std::map<std::pair<ShadowMethod, bool>, GlProgram>& programs, std::string_view what,
-                                    const std::function<std::string()>& vertex, ShadowMethod method, bool real_shadow) {
-  const std::pair<ShadowMethod, bool> key{method, real_shadow};
-  auto found = programs.find(key);
+// The program of `programs` for this variant, compiled on first use with the shading fragment
+// shader and the vertex shader `vertex` makes from the variant's defines.
+const GlProgram& program_for_variant(std::map<ShadingVariant, GlProgram>& programs, std::string_view what,
+                                     const std::function<std::string(std::string_view)>& vertex,
+                                     const ShadingVariant& variant) {
+  auto found = programs.find(variant);
   if (found == programs.end())
     found = programs
-                .emplace(key, GlProgram(shading_program_name(what, method, real_shadow), vertex(),
-                                        shading_fragment_source(method, real_shadow)))
+                .emplace(variant, GlProgram(shading_program_name(what, variant), vertex(variant_defines(variant)),
+                                            shading_fragment_source(variant)))
                 .first;
   return found->second;
 }
 
 }  // namespace
 
-const GlProgram& ObjectRenderer::shading(ShadowMethod method, bool real_shadow) {
-  return program_for_lookup(
-      shading_, "object shading", [] { return vertex_source({"pose"}, kShadingVertexShader); }, method, real_shadow);
+const GlProgram& ObjectRenderer::shading(const ShadingVariant& variant) {
+  return program_for_variant(
+      shading_, "object shading",
+      [](std::string_view defines) { return vertex_source({"pose"}, kShadingVertexShader, defines); }, variant);
 }
 
 const GlProgram& ObjectRenderer::baking(ShadowMethod method, bool real_shadow) {
-  return program_for_lookup(
-      baking_, "ground catcher bake", [] { return std::string(kCatcherBakeVertexShader); }, method, real_shadow);
+  return program_for_variant(
+      baking_, "ground catcher bake",
+      [](std::string_view defines) { return fmt::format("#version 300 es\n{}\n{}", defines, kCatcherBakeVertexShader); },
+      ShadingVariant{method, real_shadow, true, false, false});
 }
 
 namespace {
@@ -394,31 +416,31 @@ void ObjectRenderer::set_frame_uniforms(const GlProgram& program, const LensUnif
 
 void ObjectRenderer::set_light_uniforms(const GlProgram& program, const Lighting& lighting) const {
   glUseProgram(program.id());
-  set_vec3(program.uniform("u_light_direction"), lighting.direction);
-  glUniform4f(program.uniform("u_light_position"), static_cast<float>(lighting.position[0]),
+  // Each variant's compiler drops the uniforms it does not read (a PRT surface's ambient, a
+  // catcher's exposure, the lookups of a program without them): their location is -1, which
+  // glUniform ignores.
+  const auto location = [&](const char* name) { return glGetUniformLocation(program.id(), name); };
+  set_vec3(location("u_light_direction"), lighting.direction);
+  glUniform4f(location("u_light_position"), static_cast<float>(lighting.position[0]),
               static_cast<float>(lighting.position[1]), static_cast<float>(lighting.position[2]), lighting.local ? 1.0f : 0.0f);
-  set_vec3(program.uniform("u_light_color"), lighting.color);
-  set_vec3(program.uniform("u_ambient"), lighting.ambient);
+  set_vec3(location("u_light_color"), lighting.color);
+  set_vec3(location("u_ambient"), lighting.ambient);
   std::array<float, 27> sh{};
   for (size_t i = 0; i < 9; ++i)
     for (size_t c = 0; c < 3; ++c) sh[i * 3 + c] = static_cast<float>(lighting.ambient_sh[i][c]);
-  glUniform3fv(program.uniform("u_ambient_sh"), 9, sh.data());
+  glUniform3fv(location("u_ambient_sh"), 9, sh.data());
   for (size_t i = 0; i < 9; ++i)
     for (size_t c = 0; c < 3; ++c) sh[i * 3 + c] = static_cast<float>(lighting.radiance_sh[i][c]);
-  glUniform3fv(program.uniform("u_radiance_sh"), 9, sh.data());
-  glUniform1f(program.uniform("u_exposure_scale"), static_cast<float>(lighting.exposure_scale));
-  // The compiler drops the uniforms a program does not read (the lookups of a program without
-  // them, the catcher's of one that never runs it): set only those it kept.
-  const auto location = [&](const char* name) { return glGetUniformLocation(program.id(), name); };
+  glUniform3fv(location("u_radiance_sh"), 9, sh.data());
+  glUniform1f(location("u_exposure_scale"), static_cast<float>(lighting.exposure_scale));
   if (lighting.shadow && location("u_shadow_map") >= 0) set_shadow_lookup_uniforms(program, *lighting.shadow, 1);
   if (lighting.shadow && lighting.real_shadow && location("real_u_shadow_map") >= 0)
     set_shadow_lookup_uniforms(program, *lighting.real_shadow, 2, "real_");
   const int sky_occluders = static_cast<int>(std::min(lighting.sky_occluders.size(), Lighting::kMaxSkyOccluders));
-  if (location("u_sky_occluder_count") >= 0) glUniform1i(location("u_sky_occluder_count"), sky_occluders);
-  if (sky_occluders > 0 && location("u_sky_occluders") >= 0)
-    glUniform4fv(location("u_sky_occluders"), sky_occluders, lighting.sky_occluders[0].data());
-  if (location("u_catcher_patch") >= 0) glUniform4fv(location("u_catcher_patch"), 1, lighting.catcher_patch.data());
-  if (location("u_ground_radiance") >= 0) set_vec3(location("u_ground_radiance"), lighting.ground_radiance);
+  glUniform1i(location("u_sky_occluder_count"), sky_occluders);
+  if (sky_occluders > 0) glUniform4fv(location("u_sky_occluders"), sky_occluders, lighting.sky_occluders[0].data());
+  glUniform4fv(location("u_catcher_patch"), 1, lighting.catcher_patch.data());
+  set_vec3(location("u_ground_radiance"), lighting.ground_radiance);
 }
 
 void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, const Lighting& lighting,
@@ -440,30 +462,28 @@ void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, c
     set_row_projection(occluder_, rows);
   }
   // The programs this draw uses, each given the frame's uniforms and its per-object uniforms'
-  // locations on first use.
+  // locations on first use. A location the variant's compiler dropped is -1, which glUniform ignores.
   struct InUse {
     const GlProgram* program = nullptr;
-    GLint rotation = -1, translation = -1, scale = -1, shadow_catcher = -1, ground_catcher = -1, specular = -1,
-          camera_world = -1, prt = -1, prt_light = -1, base_color = -1;
+    GLint rotation = -1, translation = -1, scale = -1, ground_catcher = -1, specular = -1, camera_world = -1,
+          prt_light = -1, base_color = -1;
   };
-  InUse with_lookups, without_lookups;
-  const auto program_for = [&](const UploadedObject& object) -> const InUse& {
-    const bool plain = method == ShadowMethod::Off || unshadowed(object);
-    InUse& in_use = plain ? without_lookups : with_lookups;
+  std::map<ShadingVariant, InUse> in_use_by_variant;
+  const auto program_for = [&](const ShadingVariant& variant) -> const InUse& {
+    InUse& in_use = in_use_by_variant[variant];
     if (!in_use.program) {
-      const GlProgram& program = plain ? shading(ShadowMethod::Off, false) : shading(method, real);
+      const GlProgram& program = shading(variant);
       set_frame_uniforms(program, lens, rows, lighting);
+      const auto location = [&](const char* name) { return glGetUniformLocation(program.id(), name); };
       in_use = {&program,
                 program.uniform("u_world_from_object_rotation"),
                 program.uniform("u_world_from_object_translation"),
                 program.uniform("u_object_scale"),
-                program.uniform("u_shadow_catcher"),
-                glGetUniformLocation(program.id(), "u_ground_catcher"),
-                program.uniform("u_specular"),
-                program.uniform("u_camera_world"),
-                program.uniform("u_prt"),
-                program.uniform("u_prt_light"),
-                program.uniform("u_base_color")};
+                location("u_ground_catcher"),
+                location("u_specular"),
+                location("u_camera_world"),
+                location("u_prt_light"),
+                location("u_base_color")};
     }
     glUseProgram(in_use.program->id());
     return in_use;
@@ -500,28 +520,29 @@ void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, c
       else draw_mesh(item, lens, cull_rect, [](const MeshPart&) {});
       continue;
     }
-    const InUse& in_use = program_for(*item.object);
-    set_row_poses(*in_use.program, "pose", item.poses, item.object->scale);
-    const std::array<float, 9> rotation = column_major(item.object->T_world_object.rotation());
+    const UploadedObject& object = *item.object;
+    ShadingVariant variant;
+    if (method != ShadowMethod::Off && !unshadowed(object)) variant.method = method, variant.real_shadow = real;
+    variant.catcher = object.shadow_catcher;  // shades() draws a proxy only as a catcher
+    variant.prt = !variant.catcher && object.mesh->has_transfer();
+    variant.specular = !variant.catcher && object.specular > 0;
+    const InUse& in_use = program_for(variant);
+    set_row_poses(*in_use.program, "pose", item.poses, object.scale);
+    const std::array<float, 9> rotation = column_major(object.T_world_object.rotation());
     glUniformMatrix3fv(in_use.rotation, 1, GL_FALSE, rotation.data());
-    set_vec3(in_use.translation, item.object->T_world_object.translation());
-    glUniform1f(in_use.scale, static_cast<float>(item.object->scale));
-    glUniform1i(in_use.shadow_catcher, item.object->shadow_catcher ? 1 : 0);
-    if (in_use.ground_catcher >= 0)
-      glUniform1i(in_use.ground_catcher, item.object->shadow_catcher && !item.object->proxy ? 1 : 0);
-    glDepthMask(item.object->writes_depth ? GL_TRUE : GL_FALSE);
-    glUniform1f(in_use.specular,
-                item.object->shadow_catcher || item.object->proxy ? 0.0f : static_cast<float>(item.object->specular));
-    if (item.object->specular > 0 && !item.poses.T_cam_object.empty()) {
+    set_vec3(in_use.translation, object.T_world_object.translation());
+    glUniform1f(in_use.scale, static_cast<float>(object.scale));
+    glUniform1i(in_use.ground_catcher, object.shadow_catcher && !object.proxy ? 1 : 0);
+    glDepthMask(object.writes_depth ? GL_TRUE : GL_FALSE);
+    if (variant.specular && !item.poses.T_cam_object.empty()) {
+      glUniform1f(in_use.specular, static_cast<float>(object.specular));
       // The eye of the middle row: rows differ by far less than the reflection's blur.
       const SE3& T_cam_object = item.poses.T_cam_object[item.poses.T_cam_object.size() / 2];
-      set_vec3(in_use.camera_world, item.object->T_world_object * T_cam_object.inverse().translation());
+      set_vec3(in_use.camera_world, object.T_world_object * T_cam_object.inverse().translation());
     }
-    const bool use_prt = item.object->mesh->has_transfer() && !item.object->shadow_catcher && !item.object->proxy;
-    glUniform1i(in_use.prt, use_prt ? 1 : 0);
-    if (use_prt) {
+    if (variant.prt) {
       // The transfer lives in the object's frame: turn the world's light into it.
-      const std::array<float, 27> light = object_frame_light(lighting.radiance_sh, item.object->T_world_object.rotation());
+      const std::array<float, 27> light = object_frame_light(lighting.radiance_sh, object.T_world_object.rotation());
       glUniform3fv(in_use.prt_light, 9, light.data());
     }
     const GLint base_color = in_use.base_color;
@@ -540,9 +561,7 @@ void ObjectRenderer::bake_ground_catcher(const Lighting& lighting, const Uploade
   set_light_uniforms(program, lighting);  // binds it
   set_object_placement(program, catcher);
   glUniform4fv(program.uniform("u_bake_square"), 1, square.data());
-  glUniform1i(program.uniform("u_shadow_catcher"), 1);
-  const GLint ground_catcher = glGetUniformLocation(program.id(), "u_ground_catcher");
-  if (ground_catcher >= 0) glUniform1i(ground_catcher, 1);
+  glUniform1i(glGetUniformLocation(program.id(), "u_ground_catcher"), 1);
   glDisable(GL_DEPTH_TEST);
   glDisable(GL_BLEND);
   glDisable(GL_CULL_FACE);

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <compare>
 #include <map>
 #include <utility>
 #include <span>
@@ -70,6 +71,17 @@ struct ObjectOverExposure {
   RowPoses start, mid, end;  // at the start, middle and end of each row's exposure
 };
 
+// Which shading program draws a surface: the branches a frame would take the same way for every
+// pixel are compiled in or out, not chosen by uniforms.
+struct ShadingVariant {
+  ShadowMethod method = ShadowMethod::Off;  // the virtual objects' shadow lookup
+  bool real_shadow = false;                 // with the real casters' map (proxies that cast), else a constant 1
+  bool catcher = false;                     // a shadow catcher's ratio, not a surface's colour
+  bool prt = false;                         // a surface's environment light from its transfer (seed 002)
+  bool specular = false;                    // a surface's glossy reflection
+  auto operator<=>(const ShadingVariant&) const = default;
+};
+
 class ObjectRenderer {
  public:
   // Compiles both programs; needs a current context. Throws RenderError.
@@ -100,15 +112,14 @@ class ObjectRenderer {
                      std::span<const ObjectOverExposure> objects) const;
 
  private:
-  // real_shadow: with the real casters' map (proxies that cast), else its lookup is a constant 1.
-  const GlProgram& shading(ShadowMethod method, bool real_shadow);
+  const GlProgram& shading(const ShadingVariant& variant);
   // Binds the program and sets what every item drawn with it shares: lens, rows and light.
   void set_frame_uniforms(const GlProgram& program, const LensUniforms& lens, const RowProjection& rows,
                           const Lighting& lighting) const;
-  std::map<std::pair<ShadowMethod, bool>, GlProgram> shading_;  // one per shadow lookup
+  std::map<ShadingVariant, GlProgram> shading_;
   // The same fragment shader placed on the ground catcher's bake texture.
   const GlProgram& baking(ShadowMethod method, bool real_shadow);
-  std::map<std::pair<ShadowMethod, bool>, GlProgram> baking_;
+  std::map<ShadingVariant, GlProgram> baking_;
   // The fragment-side uniforms: the light, the shadow lookups, the catcher's; binds the program.
   void set_light_uniforms(const GlProgram& program, const Lighting& lighting) const;
   void set_object_placement(const GlProgram& program, const UploadedObject& object) const;
