@@ -289,6 +289,19 @@ void set_depth_state() {
   glFrontFace(GL_CW);
 }
 
+// A closed convex mesh's back faces are always hidden behind its front faces: culled, they cost
+// no rasterising or shading (half a sphere's triangles), and cannot tie with a front face in depth
+// along the silhouette, where the depth interpolation's rounding would pick either. An open or
+// concave mesh keeps them: its inside can show.
+void cull_back_faces_of(const UploadedObject& object) {
+  if (object.closed_convex) {
+    glEnable(GL_CULL_FACE);
+    glCullFace(GL_BACK);
+  } else {
+    glDisable(GL_CULL_FACE);
+  }
+}
+
 }  // namespace
 
 ObjectRenderer::ObjectRenderer()
@@ -508,6 +521,7 @@ void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, c
       set_row_poses(baked_catcher_, "pose", item.poses, item.object->scale);
       set_object_placement(baked_catcher_, *item.object);
       glDepthMask(item.object->writes_depth ? GL_TRUE : GL_FALSE);  // as the per-pixel path
+      cull_back_faces_of(*item.object);
       item.object->mesh->draw([](const MeshPart&) {});
       continue;
     }
@@ -516,6 +530,7 @@ void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, c
       glUseProgram(occluder_.id());
       set_row_poses(occluder_, "pose", item.poses, item.object->scale);
       glDepthMask(GL_TRUE);
+      cull_back_faces_of(*item.object);
       if (const GpuMesh* level = occluder_level_for(item, lens, occluder_lod_px)) level->draw([](const MeshPart&) {});
       else draw_mesh(item, lens, cull_rect, [](const MeshPart&) {});
       continue;
@@ -546,12 +561,14 @@ void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, c
       glUniform3fv(in_use.prt_light, 9, light.data());
     }
     const GLint base_color = in_use.base_color;
+    cull_back_faces_of(object);
     draw_mesh(item, lens, cull_rect, [&](const MeshPart& part) {
       const std::array<float, 4>& color = item.object->base_color ? *item.object->base_color : part.base_color;
       glUniform4f(base_color, color[0], color[1], color[2], color[3]);
     });
   }
   glDepthMask(GL_TRUE);
+  glDisable(GL_CULL_FACE);
 }
 
 void ObjectRenderer::bake_ground_catcher(const Lighting& lighting, const UploadedObject& catcher,
@@ -586,8 +603,10 @@ void ObjectRenderer::draw_velocity(const LensUniforms& lens, const RowProjection
     set_row_poses(velocity_, "start", item.start, item.object->scale);
     set_row_poses(velocity_, "mid", item.mid, item.object->scale);
     set_row_poses(velocity_, "end", item.end, item.object->scale);
+    cull_back_faces_of(*item.object);
     item.object->mesh->draw([](const MeshPart&) {});
   }
+  glDisable(GL_CULL_FACE);
 }
 
 }  // namespace arpipe
