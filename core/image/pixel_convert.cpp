@@ -3,51 +3,12 @@
 #include <algorithm>
 #include <cstring>
 
+#include "core/image/yuv_rows.h"
+
 namespace arpipe {
 
 namespace {
 inline uint8_t clamp8(int v) { return static_cast<uint8_t>(std::clamp(v, 0, 255)); }
-
-// BT.601 limited range to RGB in integer form (8-bit fixed point, as in libyuv's reference code):
-// with c = 298 (y - 16), d = u - 128, e = v - 128, R = (c + 409 e + 128) >> 8,
-// G = (c - 100 d - 208 e + 128) >> 8, B = (c + 516 d + 128) >> 8, each clamped to 0..255. Every term
-// comes from a table, the chroma ones once per pair of pixels, and so does the clamp: twice as fast
-// as the arithmetic, bit for bit the same.
-class YuvTables {
- public:
-  YuvTables() {
-    for (int i = 0; i < 256; ++i) {
-      luma_[i] = 298 * (i - 16) + 128;
-      red_v_[i] = 409 * (i - 128);
-      green_u_[i] = -100 * (i - 128);
-      green_v_[i] = -208 * (i - 128);
-      blue_u_[i] = 516 * (i - 128);
-    }
-    for (int i = 0; i < kClampSize; ++i) clamp_[i] = clamp8(i - kClampOffset);
-  }
-  // One or two pixels sharing chroma (u, v).
-  void decode(const uint8_t* y, int count, int u, int v, uint8_t* rgb) const {
-    const int r = red_v_[v], g = green_u_[u] + green_v_[v], b = blue_u_[u];
-    for (int i = 0; i < count; ++i, rgb += 3) {
-      const int c = luma_[y[i]];
-      rgb[0] = clamp_[((c + r) >> 8) + kClampOffset];
-      rgb[1] = clamp_[((c + g) >> 8) + kClampOffset];
-      rgb[2] = clamp_[((c + b) >> 8) + kClampOffset];
-    }
-  }
-
- private:
-  // (c + chroma) >> 8 lies in [-277, 534] for every byte triple.
-  static constexpr int kClampOffset = 384;
-  static constexpr int kClampSize = 1024;
-  int32_t luma_[256], red_v_[256], green_u_[256], green_v_[256], blue_u_[256];
-  uint8_t clamp_[kClampSize];
-};
-
-const YuvTables& yuv_tables() {
-  static const YuvTables tables;
-  return tables;
-}
 
 inline uint8_t rgb_to_y(int r, int g, int b) { return clamp8(((66 * r + 129 * g + 25 * b + 128) >> 8) + 16); }
 // Full-range BT.601 luma (0.299, 0.587, 0.114 in 8-bit fixed point; the weights sum to 256, so a
@@ -80,7 +41,6 @@ void to_grey(const Frame& f, const PixelRect& rect, std::vector<uint8_t>& out) {
 
 void to_rgb24(const Frame& f, std::vector<uint8_t>& out) {
   out.resize(size_t(f.width) * f.height * 3);
-  const YuvTables& tables = yuv_tables();
   const uint8_t* uv_plane = f.data.data() + f.bytes_per_line * size_t(f.height);
   for (int y = 0; y < f.height; ++y) {
     const uint8_t* row = f.data.data() + size_t(y) * f.bytes_per_line;
@@ -90,18 +50,8 @@ void to_rgb24(const Frame& f, std::vector<uint8_t>& out) {
       case PixelFormat::GREY:
         for (int x = 0; x < f.width; ++x) dst[3 * x] = dst[3 * x + 1] = dst[3 * x + 2] = row[x];
         break;
-      case PixelFormat::YUYV:
-        for (int x = 0; x < f.width; x += 2) {
-          const uint8_t* p = row + 2 * x;
-          const uint8_t luma[2] = {p[0], p[2]};
-          tables.decode(luma, std::min(2, f.width - x), p[1], p[3], dst + 3 * x);
-        }
-        break;
-      case PixelFormat::NV12: {
-        const uint8_t* uv = uv_plane + size_t(y / 2) * f.bytes_per_line;
-        for (int x = 0; x < f.width; x += 2) tables.decode(row + x, std::min(2, f.width - x), uv[x], uv[x + 1], dst + 3 * x);
-        break;
-      }
+      case PixelFormat::YUYV: yuyv_row_to_rgb24(row, f.width, dst); break;
+      case PixelFormat::NV12: nv12_row_to_rgb24(row, uv_plane + size_t(y / 2) * f.bytes_per_line, f.width, dst); break;
     }
   }
 }

@@ -1,5 +1,6 @@
 #include "core/track/pose_refinement.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
