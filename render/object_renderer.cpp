@@ -456,11 +456,29 @@ void ObjectRenderer::set_light_uniforms(const GlProgram& program, const Lighting
   set_vec3(location("u_ground_radiance"), lighting.ground_radiance);
 }
 
+void ObjectRenderer::draw_ground_catcher_under(const LensUniforms& lens, const RowProjection& rows,
+                                               const Lighting& lighting, const ObjectAtInstant& catcher,
+                                               const PixelRect& cull_rect) {
+  draw_items(lens, rows, lighting, std::span<const ObjectAtInstant>(&catcher, 1), cull_rect, 0, true);
+}
+
 void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, const Lighting& lighting,
                           std::span<const ObjectAtInstant> objects, const PixelRect& cull_rect, double occluder_lod_px) {
+  draw_items(lens, rows, lighting, objects, cull_rect, occluder_lod_px, false);
+}
+
+void ObjectRenderer::draw_items(const LensUniforms& lens, const RowProjection& rows, const Lighting& lighting,
+                                std::span<const ObjectAtInstant> objects, const PixelRect& cull_rect,
+                                double occluder_lod_px, bool under) {
   const ShadowMethod method = lighting.shadow ? lighting.shadow->method : ShadowMethod::Off;
   const bool real = lighting.shadow && lighting.real_shadow;
   set_depth_state();
+  if (under) {
+    glDisable(GL_DEPTH_TEST);
+    glEnable(GL_BLEND);
+    glBlendEquation(GL_FUNC_ADD);
+    glBlendFunc(GL_ONE_MINUS_DST_ALPHA, GL_ONE);
+  }
   // A proxy shades only to catch a shadow; without one this frame it hides (depth only) or is
   // not drawn at all.
   const auto shades = [&](const UploadedObject& object) { return !object.proxy || (object.shadow_catcher && lighting.shadow); };
@@ -569,6 +587,7 @@ void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, c
   }
   glDepthMask(GL_TRUE);
   glDisable(GL_CULL_FACE);
+  glDisable(GL_BLEND);
 }
 
 void ObjectRenderer::bake_ground_catcher(const Lighting& lighting, const UploadedObject& catcher,

@@ -102,6 +102,13 @@ class ObjectRenderer {
   // this far at its nearest point (UploadedObject::occluder_levels); 0: its full mesh.
   void draw(const LensUniforms& lens, const RowProjection& rows, const Lighting& lighting,
             std::span<const ObjectAtInstant> objects, const PixelRect& cull_rect, double occluder_lod_px = 0);
+  // Draws the ground catcher as draw() would, but under what the bound framebuffer holds already
+  // (premultiplied: dst + (1 - dst.a) src), without depth: into the resolved layer, after the
+  // objects were drawn and resolved without it. Where an object covers a fraction a of a pixel's
+  // samples this gives a object + (1 - a) catcher, as multisampling both together does (both are
+  // shaded once per pixel), at one sample per pixel over the catcher's large patch.
+  void draw_ground_catcher_under(const LensUniforms& lens, const RowProjection& rows, const Lighting& lighting,
+                                 const ObjectAtInstant& catcher, const PixelRect& cull_rect);
   // Draws the ground catcher's alpha (1 - ratio, as draw() gives it per pixel) over the world
   // square (x, y min and max) into the bound framebuffer's viewport, x right and y up: the texel
   // centre (i + 0.5, j + 0.5) / size holds the ground point there. Needs lighting.shadow.
@@ -112,6 +119,10 @@ class ObjectRenderer {
                      std::span<const ObjectOverExposure> objects) const;
 
  private:
+  // under: as draw_ground_catcher_under (no depth test, blended under the framebuffer's contents).
+  void draw_items(const LensUniforms& lens, const RowProjection& rows, const Lighting& lighting,
+                  std::span<const ObjectAtInstant> objects, const PixelRect& cull_rect, double occluder_lod_px,
+                  bool under);
   const GlProgram& shading(const ShadingVariant& variant);
   // Binds the program and sets what every item drawn with it shares: lens, rows and light.
   void set_frame_uniforms(const GlProgram& program, const LensUniforms& lens, const RowProjection& rows,

@@ -286,6 +286,7 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
   for (const UploadedObject& object : objects_)
     if (object.present && rect_of(object, rect)) request.objects.push_back(&object);
   if (request.objects.empty()) return Drawn::OutOfView;
+  const PixelRect objects_rect = rect;  // before the proxies and the shadows' receivers join it
   // Proxies in view go first: those that hide write their depth, so that the objects' fragments
   // behind them fail the depth test before they are shaded; then those that receive shadows but
   // hide nothing, without depth, so that the objects cover them.
@@ -341,6 +342,13 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
   }
   if (settings_.full_canvas) rect = PixelRect::full(camera.width(), camera.height());
   request.rect = warp ? warp->canvas_rect_for(rect) : rect;
+  // The ground catcher under the multisampled objects when nothing else is drawn: a proxy that
+  // hides must hide the catcher too, which needs the depth the objects' samples hold.
+  request.catcher_under = request.lighting.shadow && occluders.empty() && receivers_first.empty();
+  if (request.catcher_under) {
+    const PixelRect objects_only = settings_.full_canvas ? rect : objects_rect;
+    request.objects_rect = (warp ? warp->canvas_rect_for(objects_only) : objects_only).intersected(request.rect);
+  }
   request.image_motion_px = motion.valid() ? std::max(motion.max_image_motion_px, moving_objects_motion_px(motion, image_camera)) : 0;
   request.msaa_samples = settings_.msaa_samples;
   request.rolling_shutter = settings_.rolling_shutter;

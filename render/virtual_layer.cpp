@@ -6,6 +6,7 @@
 
 #include "core/log.h"
 #include "render/gl/gl_error.h"
+#include "render/gl/render_errors.h"
 #include "render/gl/texture_target.h"
 
 namespace arpipe {
@@ -55,6 +56,7 @@ void VirtualLayer::ensure(int width, int height, int msaa_samples) {
   height_ = height;
   requested_samples_ = msaa_samples;
   samples_ = samples;
+  objects_width_ = objects_height_ = 0;  // the objects' image follows the sample count
   resolved_written_ = PixelRect::full(width, height);
 }
 
@@ -71,6 +73,76 @@ void VirtualLayer::begin(const PixelRect& rect) {
   glClearBufferfv(GL_COLOR, 0, transparent);
   const GLfloat far_depth = 1.0f;
   glClearBufferfv(GL_DEPTH, 0, &far_depth);
+}
+
+void VirtualLayer::ensure_objects_image(int width, int height) {
+  if (width == objects_width_ && height == objects_height_ && objects_framebuffer_.get() != 0) return;
+  objects_color_ = GlRenderbuffer::create();
+  glBindRenderbuffer(GL_RENDERBUFFER, objects_color_.get());
+  glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples_, color_format_, width, height);
+  objects_depth_ = GlRenderbuffer::create();
+  glBindRenderbuffer(GL_RENDERBUFFER, objects_depth_.get());
+  glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples_, GL_DEPTH_COMPONENT24, width, height);
+  objects_framebuffer_ = GlFramebuffer::create();
+  glBindFramebuffer(GL_FRAMEBUFFER, objects_framebuffer_.get());
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, objects_color_.get());
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, objects_depth_.get());
+  check_framebuffer_complete("virtual layer (the objects' image)");
+  objects_resolved_ = create_texel_texture(color_format_, width, height);
+  objects_resolved_framebuffer_ = create_framebuffer_for(objects_resolved_.get());
+  check_framebuffer_complete("virtual layer (the objects' image, resolved)");
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  check_gl("allocating the objects' image");
+  objects_width_ = width;
+  objects_height_ = height;
+}
+
+void VirtualLayer::begin_objects(const WorkArea& area, const PixelRect& rect, const PixelRect& objects_rect) {
+  if (samples_ <= 1) throw RenderError("the objects' own image needs multisampling");
+  const GLfloat transparent[4] = {0, 0, 0, 0};
+  glEnable(GL_SCISSOR_TEST);
+  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  clear_written_outside(resolved_framebuffer_.get(), resolved_written_, rect);
+  glBindFramebuffer(GL_FRAMEBUFFER, resolved_framebuffer_.get());
+  glViewport(0, 0, width_, height_);
+  glScissor(rect.x, rect.y, rect.width, rect.height);
+  glClearBufferfv(GL_COLOR, 0, transparent);  // one sample a pixel: cheap, unlike the multisampled clear
+  ensure_objects_image(area.width, area.height);
+  objects_area_ = area;
+  objects_rect_ = objects_rect;
+  glBindFramebuffer(GL_FRAMEBUFFER, objects_framebuffer_.get());
+  glDisable(GL_SCISSOR_TEST);  // a whole clear: see work_area.h
+  glDepthMask(GL_TRUE);
+  glClearBufferfv(GL_COLOR, 0, transparent);
+  const GLfloat far_depth = 1.0f;
+  glClearBufferfv(GL_DEPTH, 0, &far_depth);
+  glViewport(-area.x, -area.y, width_, height_);
+  const PixelRect local = area.local(objects_rect);
+  glEnable(GL_SCISSOR_TEST);
+  glScissor(local.x, local.y, local.width, local.height);
+}
+
+void VirtualLayer::resolve_objects() {
+  const PixelRect local = objects_area_.local(objects_rect_);
+  const PixelRect& to = objects_rect_;
+  glDisable(GL_SCISSOR_TEST);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, objects_framebuffer_.get());
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, objects_resolved_framebuffer_.get());
+  glBlitFramebuffer(local.x, local.y, local.right(), local.bottom(), local.x, local.y, local.right(), local.bottom(),
+                    GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  // A plain copy to its place (a multisample resolve may not move it).
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, objects_resolved_framebuffer_.get());
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, resolved_framebuffer_.get());
+  glBlitFramebuffer(local.x, local.y, local.right(), local.bottom(), to.x, to.y, to.right(), to.bottom(),
+                    GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+void VirtualLayer::begin_resolved(const PixelRect& rect) {
+  glBindFramebuffer(GL_FRAMEBUFFER, resolved_framebuffer_.get());
+  glViewport(0, 0, width_, height_);
+  glEnable(GL_SCISSOR_TEST);
+  glScissor(rect.x, rect.y, rect.width, rect.height);
 }
 
 void VirtualLayer::resolve(const PixelRect& rect) {

@@ -5,6 +5,7 @@
 #include "render/gl/egl_context.h"
 #include "render/gl/gl_objects.h"
 #include "core/image/pixel_rect.h"
+#include "render/work_area.h"
 
 namespace arpipe {
 
@@ -25,6 +26,17 @@ class VirtualLayer {
   // Makes what was drawn inside rect available in texture().
   void resolve(const PixelRect& rect);
 
+  // For objects drawn apart from what follows them (the ground catcher): clears texture() inside
+  // rect (and what earlier frames left outside it, as begin), then binds a multisampled image of
+  // `area` alone (work_area.h), cleared whole, to draw into with viewport = the canvas placed so
+  // that canvas pixel (area.x, area.y) lands on its texel (0, 0), scissor = objects_rect (canvas
+  // pixels, within area) seen there. Needs samples() > 1.
+  void begin_objects(const WorkArea& area, const PixelRect& rect, const PixelRect& objects_rect);
+  // Resolves what was drawn since begin_objects and copies it to its place in texture().
+  void resolve_objects();
+  // Binds texture()'s framebuffer to draw into, viewport = whole image, scissor = rect.
+  void begin_resolved(const PixelRect& rect);
+
   GLuint texture() const { return resolved_texture_.get(); }
   GLuint resolved_framebuffer() const { return resolved_framebuffer_.get(); }  // texture()'s
   GLenum color_format() const { return color_format_; }
@@ -44,6 +56,17 @@ class VirtualLayer {
   GlRenderbuffer multisample_color_;
   GlRenderbuffer depth_;
   GlFramebuffer draw_framebuffer_;
+  // The objects' image over a work area: multisampled colour and depth, and its resolve.
+  void ensure_objects_image(int width, int height);
+  int objects_width_ = 0;
+  int objects_height_ = 0;
+  GlRenderbuffer objects_color_;
+  GlRenderbuffer objects_depth_;
+  GlFramebuffer objects_framebuffer_;
+  GlTexture objects_resolved_;
+  GlFramebuffer objects_resolved_framebuffer_;
+  WorkArea objects_area_;
+  PixelRect objects_rect_;
   PixelRect resolved_written_;  // what texture() may hold: all of it after allocation  // the multisampled one, or resolved_framebuffer_'s twin with depth
 };
 

@@ -9,6 +9,7 @@
 
 #include "core/motion/intraframe_warp_plan.h"
 #include "render/gl/gl_error.h"
+#include "render/gl/render_errors.h"
 
 namespace arpipe {
 namespace {
@@ -45,10 +46,25 @@ void MotionBlurDrawer::prepare(BlurMethod method) {
 }
 
 void MotionBlurDrawer::draw_at(VirtualLayer& layer, const LayerDrawRequest& request, double exposure_fraction) {
-  layer.begin(request.rect);
   const std::vector<ObjectAtInstant> objects = objects_at(request, exposure_fraction);
-  objects_.draw(request.lens, request.rows, request.lighting, objects, request.rect, request.occluder_lod_px);
-  layer.resolve(request.rect);
+  if (!request.catcher_under || layer.samples() <= 1 || objects.empty()) {
+    layer.begin(request.rect);
+    objects_.draw(request.lens, request.rows, request.lighting, objects, request.rect, request.occluder_lod_px);
+    layer.resolve(request.rect);
+    return;
+  }
+  // Multisampled only where the objects reach, in an image of that area alone; the catcher's wide
+  // patch after it, at one sample per pixel.
+  const WorkArea area = objects_area_.choose(request.objects_rect, request.lens.width, request.lens.height);
+  if (area.width <= 0) throw RenderError("the objects' rectangle lies outside the canvas");
+  layer.begin_objects(area, request.rect, request.objects_rect);
+  const std::span<const ObjectAtInstant> without_catcher(objects.data(), objects.size() - 1);
+  objects_.draw(request.lens, request.rows, request.lighting, without_catcher, request.objects_rect,
+                request.occluder_lod_px);
+  layer.resolve_objects();
+  layer.begin_resolved(request.rect);
+  objects_.draw_ground_catcher_under(request.lens, request.rows, request.lighting, objects.back(), request.rect);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
 LayerDrawResult MotionBlurDrawer::draw(VirtualLayer& layer, const LayerDrawRequest& request, const BlurConfig& config) {

@@ -18,6 +18,7 @@
 #include "render/gl/texture_target.h"
 #include "render/blur/velocity_blur_pass.h"
 #include "render/virtual_layer.h"
+#include "render/work_area.h"
 
 namespace arpipe {
 
@@ -33,6 +34,11 @@ struct LayerDrawRequest {
   RowProjection rows;                      // which row of the real image a camera point lies on
   Lighting lighting;
   PixelRect rect;                          // canvas pixels that the objects can reach over the exposure
+  // With catcher_under: the ground catcher (objects.back(), no proxy among objects) is drawn after
+  // the multisampled objects, under them, at one sample per pixel (ObjectRenderer::
+  // draw_ground_catcher_under); objects_rect (within rect) is what the others can reach.
+  bool catcher_under = false;
+  PixelRect objects_rect;
   double image_motion_px = 0;              // ShutterMotion::max_image_motion_px
   int msaa_samples = 4;
   bool rolling_shutter = true;
@@ -71,6 +77,7 @@ class MotionBlurDrawer {
   std::unique_ptr<VelocityBlurPass> velocity_;
   TextureTarget first_intraframe_;
   TextureTarget velocity_image_;
+  WorkAreaChooser objects_area_;  // the objects' multisampled image with catcher_under
 };
 
 }  // namespace arpipe

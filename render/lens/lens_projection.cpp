@@ -29,14 +29,21 @@ vec2 lens_distort(vec2 p) {
   return p * radial + vec2(p1 * xy2 + p2 * (r2 + 2.0 * p.x * p.x), p1 * (r2 + 2.0 * p.y * p.y) + p2 * xy2);
 }
 
+// A window position on the rasteriser's 1/256-pixel grid (llvmpipe's subpixel precision) before
+// GL's viewport transform moves it: that transform rounds a little differently for a viewport
+// placed elsewhere (the objects' own image, render/work_area.h), which can move a vertex to the
+// next grid point and flip a sample at an edge; from a grid point its rounding comes back to it.
+vec2 on_subpixel_grid(vec2 pixel) { return floor(pixel * 256.0 + 0.5) / 256.0; }
+
 vec4 camera_to_clip(vec3 p) {
   vec2 clip_xy;
-  if (u_lens_distorted && p.z > kNear) {
-    vec2 pixel = u_lens_focal_center.xy * lens_distort(p.xy / p.z) + u_lens_focal_center.zw;
+  if (p.z > kNear) {
+    vec2 pixel = u_lens_distorted ? lens_distort(p.xy / p.z) : p.xy / p.z;
+    pixel = on_subpixel_grid(u_lens_focal_center.xy * pixel + u_lens_focal_center.zw);
     clip_xy = ((2.0 * pixel + 1.0) / u_image_size - 1.0) * p.z;
   } else {
-    // Pinhole written without the division: linear in p, so GL's clipping stays exact for
-    // triangles that reach behind the camera. (With distortion such vertices get clipped anyway.)
+    // Behind the near plane (GL clips it away): written without the division, linear in p, so
+    // that GL's clipping of a triangle reaching behind the camera stays exact.
     vec2 pixel_times_z = u_lens_focal_center.xy * p.xy + u_lens_focal_center.zw * p.z;
     clip_xy = (2.0 * pixel_times_z + p.z) / u_image_size - p.z;
   }
