@@ -462,6 +462,21 @@ void ObjectRenderer::draw_ground_catcher_under(const LensUniforms& lens, const R
   draw_items(lens, rows, lighting, std::span<const ObjectAtInstant>(&catcher, 1), cull_rect, 0, true);
 }
 
+void ObjectRenderer::draw_ground_catcher_depth(const LensUniforms& lens, const RowProjection& rows,
+                                               const ObjectAtInstant& catcher) {
+  set_depth_state();
+  set_lens_uniforms(occluder_, lens);  // binds it
+  set_row_projection(occluder_, rows);
+  set_row_poses(occluder_, "pose", catcher.poses, catcher.object->scale);
+  glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+  glDepthMask(GL_TRUE);
+  glEnable(GL_POLYGON_OFFSET_FILL);
+  glPolygonOffset(1.0f, 1.0f);
+  catcher.object->mesh->draw([](const MeshPart&) {});
+  glDisable(GL_POLYGON_OFFSET_FILL);
+  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+}
+
 void ObjectRenderer::draw(const LensUniforms& lens, const RowProjection& rows, const Lighting& lighting,
                           std::span<const ObjectAtInstant> objects, const PixelRect& cull_rect, double occluder_lod_px) {
   draw_items(lens, rows, lighting, objects, cull_rect, occluder_lod_px, false);

@@ -109,6 +109,10 @@ class ObjectRenderer {
   // shaded once per pixel), at one sample per pixel over the catcher's large patch.
   void draw_ground_catcher_under(const LensUniforms& lens, const RowProjection& rows, const Lighting& lighting,
                                  const ObjectAtInstant& catcher, const PixelRect& cull_rect);
+  // The ground catcher's depth alone (no colour), a little behind its true depth (a polygon
+  // offset, so that an object standing on the ground wins along its foot): drawn before the objects
+  // whose catcher comes under them, so that what of an object lies below the ground stays hidden.
+  void draw_ground_catcher_depth(const LensUniforms& lens, const RowProjection& rows, const ObjectAtInstant& catcher);
   // Draws the ground catcher's alpha (1 - ratio, as draw() gives it per pixel) over the world
   // square (x, y min and max) into the bound framebuffer's viewport, x right and y up: the texel
   // centre (i + 0.5, j + 0.5) / size holds the ground point there. Needs lighting.shadow.

@@ -59,6 +59,7 @@ void MotionBlurDrawer::draw_at(VirtualLayer& layer, const LayerDrawRequest& requ
   if (area.width <= 0) throw RenderError("the objects' rectangle lies outside the canvas");
   layer.begin_objects(area, request.rect, request.objects_rect);
   const std::span<const ObjectAtInstant> without_catcher(objects.data(), objects.size() - 1);
+  objects_.draw_ground_catcher_depth(request.lens, request.rows, objects.back());
   objects_.draw(request.lens, request.rows, request.lighting, without_catcher, request.objects_rect,
                 request.occluder_lod_px);
   layer.resolve_objects();
