@@ -19,6 +19,7 @@
 #include "core/log.h"
 #include "core/pipeline/monotonic_clock.h"
 #include "render/gl/gl_error.h"
+#include "render/gl/pass_times.h"
 #include "render/lens/lens_projection.h"
 #include "render/lens/lens_undistortion.h"
 #include "render/projected_bounds.h"
@@ -363,6 +364,8 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
     return Drawn::Reused;
   }
   session_->make_current();
+  pass_times::set_frame_kind(settings_.msaa_samples, request.lighting.shadow != nullptr);
+  pass_times::start();
   if (request.lighting.shadow && settings_.shadows.bake_catcher) {
     if (!catcher_bake_) catcher_bake_ = std::make_unique<CatcherBake>(session_->layer().color_format() == GL_RGBA16F);
     const UploadedObject& catcher = *request.objects.back();
@@ -371,13 +374,16 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
         drawer_->objects(), request.lighting, catcher, catcher_texels_needed(catcher, exposure_poses, focal_px), shadow_redrawn);
   }
   VirtualLayer& layer = session_->layer();
+  pass_times::mark("catcher bake");
   const LayerDrawResult drawn = drawer_->draw(layer, request, settings_.blur);
   glDisable(GL_SCISSOR_TEST);
   GLuint drawn_texture = drawn.texture;
   if (warp) {
     if (!warp_pass_) warp_pass_ = std::make_unique<LensWarpPass>(layer.color_format());
     warp_pass_->set_map(warp);
+    pass_times::start();
     warp_pass_->run(drawn_texture, rect);
+    pass_times::mark("lens warp");
     drawn_texture = warp_pass_->texture();
   }
   // The work is queued until something waits for it; waiting here keeps the stage timings honest.

@@ -10,6 +10,25 @@
 #include "render/gl/texture_target.h"
 
 namespace arpipe {
+namespace {
+
+GlRenderbuffer multisample_storage(GLenum format, int samples, int width, int height) {
+  GlRenderbuffer buffer = GlRenderbuffer::create();
+  glBindRenderbuffer(GL_RENDERBUFFER, buffer.get());
+  glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, format, width, height);
+  return buffer;
+}
+
+// The bound framebuffer (within the scissor, when on) to transparent black and far depth.
+void clear_to_transparent_and_far() {
+  const GLfloat transparent[4] = {0, 0, 0, 0};
+  const GLfloat far_depth = 1.0f;
+  glDepthMask(GL_TRUE);
+  glClearBufferfv(GL_COLOR, 0, transparent);
+  glClearBufferfv(GL_DEPTH, 0, &far_depth);
+}
+
+}  // namespace
 
 VirtualLayer::VirtualLayer(const EglContext& context)
     : color_format_(context.has_gl_extension("GL_EXT_color_buffer_float") ||
@@ -33,19 +52,18 @@ void VirtualLayer::ensure(int width, int height, int msaa_samples) {
   resolved_framebuffer_ = create_framebuffer_for(resolved_texture_.get());
   check_framebuffer_complete("virtual layer (resolved)");
 
-  depth_ = GlRenderbuffer::create();
-  glBindRenderbuffer(GL_RENDERBUFFER, depth_.get());
   draw_framebuffer_ = GlFramebuffer::create();
-  glBindFramebuffer(GL_FRAMEBUFFER, draw_framebuffer_.get());
   if (samples > 1) {
-    glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_DEPTH_COMPONENT24, width, height);
-    multisample_color_ = GlRenderbuffer::create();
-    glBindRenderbuffer(GL_RENDERBUFFER, multisample_color_.get());
-    glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, color_format_, width, height);
+    depth_ = multisample_storage(GL_DEPTH_COMPONENT24, samples, width, height);
+    multisample_color_ = multisample_storage(color_format_, samples, width, height);
+    glBindFramebuffer(GL_FRAMEBUFFER, draw_framebuffer_.get());
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, multisample_color_.get());
   } else {
+    depth_ = GlRenderbuffer::create();
+    glBindRenderbuffer(GL_RENDERBUFFER, depth_.get());
     glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, width, height);
     multisample_color_.reset();
+    glBindFramebuffer(GL_FRAMEBUFFER, draw_framebuffer_.get());
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, resolved_texture_.get(), 0);
   }
   glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_.get());
@@ -61,7 +79,6 @@ void VirtualLayer::ensure(int width, int height, int msaa_samples) {
 }
 
 void VirtualLayer::begin(const PixelRect& rect) {
-  const GLfloat transparent[4] = {0, 0, 0, 0};
   glEnable(GL_SCISSOR_TEST);
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   clear_written_outside(resolved_framebuffer_.get(), resolved_written_, rect);
@@ -69,20 +86,13 @@ void VirtualLayer::begin(const PixelRect& rect) {
   glViewport(0, 0, width_, height_);
   // GL rows are image rows (see lens_projection.h), so the rectangle needs no flip.
   glScissor(rect.x, rect.y, rect.width, rect.height);
-  glDepthMask(GL_TRUE);
-  glClearBufferfv(GL_COLOR, 0, transparent);
-  const GLfloat far_depth = 1.0f;
-  glClearBufferfv(GL_DEPTH, 0, &far_depth);
+  clear_to_transparent_and_far();
 }
 
 void VirtualLayer::ensure_objects_image(int width, int height) {
   if (width == objects_width_ && height == objects_height_ && objects_framebuffer_.get() != 0) return;
-  objects_color_ = GlRenderbuffer::create();
-  glBindRenderbuffer(GL_RENDERBUFFER, objects_color_.get());
-  glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples_, color_format_, width, height);
-  objects_depth_ = GlRenderbuffer::create();
-  glBindRenderbuffer(GL_RENDERBUFFER, objects_depth_.get());
-  glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples_, GL_DEPTH_COMPONENT24, width, height);
+  objects_color_ = multisample_storage(color_format_, samples_, width, height);
+  objects_depth_ = multisample_storage(GL_DEPTH_COMPONENT24, samples_, width, height);
   objects_framebuffer_ = GlFramebuffer::create();
   glBindFramebuffer(GL_FRAMEBUFFER, objects_framebuffer_.get());
   glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, objects_color_.get());
@@ -112,10 +122,7 @@ void VirtualLayer::begin_objects(const WorkArea& area, const PixelRect& rect, co
   objects_rect_ = objects_rect;
   glBindFramebuffer(GL_FRAMEBUFFER, objects_framebuffer_.get());
   glDisable(GL_SCISSOR_TEST);  // a whole clear: see work_area.h
-  glDepthMask(GL_TRUE);
-  glClearBufferfv(GL_COLOR, 0, transparent);
-  const GLfloat far_depth = 1.0f;
-  glClearBufferfv(GL_DEPTH, 0, &far_depth);
+  clear_to_transparent_and_far();
   glViewport(-area.x, -area.y, width_, height_);
   const PixelRect local = area.local(objects_rect);
   glEnable(GL_SCISSOR_TEST);

@@ -1,8 +1,8 @@
 // Where on the canvas the objects' multisampled image lies (render/virtual_layer.h,
 // VirtualLayer::begin_objects): a texture only a little larger than what the objects can reach,
-// so that llvmpipe clears and resolves it whole. Its multisampled clear and resolve cost per tile
-// of the whole framebuffer, whatever the scissor (measured: a scissored clear of a 208x182
-// rectangle at 4 samples took 0.99 ms on the 990x744 canvas; the whole canvas cleared took 1.93 ms).
+// so that llvmpipe clears and resolves it whole: its multisampled clear and resolve cost per tile
+// of the whole framebuffer, whatever the scissor (ARPIPE_GL_PASS_TIMES, render/gl/pass_times.h,
+// shows each pass's share).
 #pragma once
 
 #include "core/image/pixel_rect.h"

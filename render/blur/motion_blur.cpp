@@ -9,6 +9,7 @@
 
 #include "core/motion/intraframe_warp_plan.h"
 #include "render/gl/gl_error.h"
+#include "render/gl/pass_times.h"
 #include "render/gl/render_errors.h"
 
 namespace arpipe {
@@ -47,29 +48,40 @@ void MotionBlurDrawer::prepare(BlurMethod method) {
 
 void MotionBlurDrawer::draw_at(VirtualLayer& layer, const LayerDrawRequest& request, double exposure_fraction) {
   const std::vector<ObjectAtInstant> objects = objects_at(request, exposure_fraction);
+  pass_times::start();
   if (!request.catcher_under || layer.samples() <= 1 || objects.empty()) {
     layer.begin(request.rect);
+    pass_times::mark("clear");
     objects_.draw(request.lens, request.rows, request.lighting, objects, request.rect, request.occluder_lod_px);
+    pass_times::mark("objects");
     layer.resolve(request.rect);
+    pass_times::mark("resolve");
     return;
   }
   // Multisampled only where the objects reach, in an image of that area alone; the catcher's wide
   // patch after it, at one sample per pixel.
-  const WorkArea area = objects_area_.choose(request.objects_rect, request.lens.width, request.lens.height);
-  if (area.width <= 0) throw RenderError("the objects' rectangle lies outside the canvas");
-  layer.begin_objects(area, request.rect, request.objects_rect);
+  layer.begin_objects(objects_area_, request.rect, request.objects_rect);
+  pass_times::mark("clear");
   const std::span<const ObjectAtInstant> without_catcher(objects.data(), objects.size() - 1);
   objects_.draw_ground_catcher_depth(request.lens, request.rows, objects.back());
   objects_.draw(request.lens, request.rows, request.lighting, without_catcher, request.objects_rect,
                 request.occluder_lod_px);
+  pass_times::mark("objects");
   layer.resolve_objects();
+  pass_times::mark("resolve and copy");
   layer.begin_resolved(request.rect);
   objects_.draw_ground_catcher_under(request.lens, request.rows, request.lighting, objects.back(), request.rect);
+  pass_times::mark("catcher");
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
 LayerDrawResult MotionBlurDrawer::draw(VirtualLayer& layer, const LayerDrawRequest& request, const BlurConfig& config) {
   layer.ensure(request.lens.width, request.lens.height, request.msaa_samples);
+  if (request.catcher_under && layer.samples() > 1) {
+    // Once a frame, for every draw of it (the blur methods draw the objects several times).
+    objects_area_ = objects_area_chooser_.choose(request.objects_rect, request.lens.width, request.lens.height);
+    if (objects_area_.width <= 0) throw RenderError("the objects' rectangle lies outside the canvas");
+  }
   const BlurMethod method = config.method;
   LayerDrawResult result;
   if (method != BlurMethod::Off) {
@@ -129,8 +141,11 @@ LayerDrawResult MotionBlurDrawer::draw_intraframe_warp(VirtualLayer& layer, cons
   draw_at(layer, request, kFirstIntraframe);
   first_intraframe_.ensure(layer.color_format(), layer.width(), layer.height(), false);
   first_intraframe_.copy_from(layer.resolved_framebuffer(), request.rect);
+  pass_times::mark("intraframe copy");
   draw_at(layer, request, kSecondIntraframe);
+  pass_times::start();
   seed_->run(first_intraframe_.texture(), layer.texture(), layer.width(), layer.height(), plan, request.rect);
+  pass_times::mark("seed blur");
   return {seed_->texture(), BlurMethod::IntraframeWarp, static_cast<int>(plan.samples.size()), {}};
 }
 

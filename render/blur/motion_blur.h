@@ -77,7 +77,8 @@ class MotionBlurDrawer {
   std::unique_ptr<VelocityBlurPass> velocity_;
   TextureTarget first_intraframe_;
   TextureTarget velocity_image_;
-  WorkAreaChooser objects_area_;  // the objects' multisampled image with catcher_under
+  WorkAreaChooser objects_area_chooser_;  // the objects' multisampled image with catcher_under
+  WorkArea objects_area_;                 // this frame's
 };
 
 }  // namespace arpipe
