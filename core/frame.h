@@ -3,9 +3,11 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string_view>
 #include <vector>
 
+#include "core/geometry/se3.h"
 #include "core/pixel_format.h"
 
 namespace arpipe {
@@ -34,6 +36,10 @@ struct FrameMetadata {
   // ColourTemperature); 0 when unknown.
   double lux = 0;
   double colour_temperature_k = 0;
+  // Where the camera was, when the source knows it rather than a tracker (a panorama's view
+  // camera, turned by its configured sweep): T_cam_world at exposure_mid_ns. The track stage then
+  // takes it instead of detecting tags.
+  std::optional<SE3> known_T_cam_world;
 
   // Middle of the exposure of the middle row: where a single pose for the frame belongs.
   int64_t exposure_mid_ns() const { return exposure_start_ns + (exposure_ns + readout_ns) / 2; }

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "capture/live/live_source.h"
+#include "capture/panorama/panorama_source.h"
 #include "capture/replay_source.h"
 #include "capture/sinks/gstreamer/gstreamer_sink.h"
 #include "capture/sinks/http/http_sink.h"
@@ -25,6 +26,7 @@ std::unique_ptr<FrameSource> make_source(const Config& config) {
     case SourceType::Replay: return std::make_unique<ReplaySource>(config.source);
     case SourceType::V4l2:
     case SourceType::Libcamera: return make_live_source(config.source);
+    case SourceType::Panorama: return std::make_unique<PanoramaSource>(config.source);
   }
   throw ConfigError(fmt::format("{}: source.type is not one of {}", config.file.string(),
                                 choice_list(ChoiceNames<SourceType>(kSourceTypeNames))));

@@ -16,6 +16,7 @@
 #include "core/config/source_choices.h"
 #include "core/config/light_source.h"
 #include "core/config/object_prt.h"
+#include "core/config/panorama_config.h"
 #include "core/config/physics_choices.h"
 #include "core/config/proxy_roles.h"
 #include "core/config/probe_kind.h"
@@ -62,6 +63,7 @@ struct SourceConfig {
   int64_t frame_timeout_ms = 1000;      // a frame later than this is a timeout (counted)
   int64_t reconnect_min_ms = 100;       // first retry after a camera disappeared
   int64_t reconnect_max_ms = 5000;      // retries back off up to this
+  PanoramaConfig panorama;              // type = "panorama"
 
   bool operator==(const SourceConfig&) const = default;
 };
@@ -70,7 +72,7 @@ struct SourceConfig {
 // rule the value must meet, and the help `arpipe config --defaults` prints (docs/ARCHITECTURE.md, "Adding a config key").
 template <class V>
 void visit(V& v, SourceConfig& s) {
-  v.key("type", s.type, kSourceTypeNames, "a recording, a V4L2 device or a libcamera camera");
+  v.key("type", s.type, kSourceTypeNames, "a recording, a V4L2 device, a libcamera camera or a 360° panorama");
   v.key("path", s.path, "replay: the recording directory");
   v.key("pacing", s.pacing, kReplayPacingNames, "replay: real time, or as fast as the pipeline runs");
   v.key("loop", s.loop, "replay: start again at the end (soak tests)");
@@ -98,6 +100,7 @@ void visit(V& v, SourceConfig& s) {
   v.key("frame_timeout_ms", s.frame_timeout_ms, IntRange{1, 600'000}, "a frame later than this is a timeout");
   v.key("reconnect_min_ms", s.reconnect_min_ms, IntRange{1, 600'000}, "first retry after the camera went away");
   v.key("reconnect_max_ms", s.reconnect_max_ms, IntRange{1, 3'600'000}, "retries back off up to this (>= reconnect_min_ms)");
+  v.section("panorama", s.panorama, "type = \"panorama\": a 360° still seen through a turning view camera");
 }
 
 // One tag of the anchor bundle: where its centre sits in the world (anchor) frame and how it is turned.

@@ -36,6 +36,8 @@ std::string one_of_phrase(const std::vector<std::string_view>& names) {
 }
 
 void check_cross_keys(const TomlSection& t, SourceConfig& s) {
+  if (s.type == SourceType::Panorama && s.panorama.file.empty())
+    t.fail_with("type", "expected source.panorama.file to be set when the type is \"panorama\"");
   if (s.reconnect_max_ms < s.reconnect_min_ms)
     t.fail(t.has("reconnect_max_ms") ? "reconnect_max_ms" : "reconnect_min_ms",
            fmt::format("at least reconnect_min_ms ({})", s.reconnect_min_ms), fmt::format("{}", s.reconnect_max_ms));

@@ -11,9 +11,11 @@
 namespace arpipe {
 
 // Where the frames come from (source.type).
-enum class SourceType { Replay, V4l2, Libcamera };
-inline constexpr ChoiceName<SourceType> kSourceTypeNames[] = {
-    {"replay", SourceType::Replay}, {"v4l2", SourceType::V4l2}, {"libcamera", SourceType::Libcamera}};
+enum class SourceType { Replay, V4l2, Libcamera, Panorama };
+inline constexpr ChoiceName<SourceType> kSourceTypeNames[] = {{"replay", SourceType::Replay},
+                                                              {"v4l2", SourceType::V4l2},
+                                                              {"libcamera", SourceType::Libcamera},
+                                                              {"panorama", SourceType::Panorama}};
 
 // How a replay is paced (source.pacing): by its timestamps (real time) or as fast as the pipeline runs.
 enum class ReplayPacing { Timestamps, Fast };

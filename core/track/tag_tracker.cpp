@@ -492,6 +492,16 @@ void TagTracker::process(FrameContext& ctx) noexcept {
   const auto start = std::chrono::steady_clock::now();
   std::string skipped;
   ctx.pose = PoseEstimate{};
+  if (ctx.camera.meta.known_T_cam_world) {
+    // The source knows where its camera looked (a panorama's view): nothing to detect.
+    ctx.pose.state = TrackState::Tracking;
+    ctx.pose.T_cam_world = *ctx.camera.meta.known_T_cam_world;
+    try {
+      ctx.record_timing("track", milliseconds_since(start), "pose given by the source");
+    } catch (...) {
+    }
+    return;
+  }
   try {
     skipped = impl_->why_not_trackable(ctx);
     if (skipped.empty()) {

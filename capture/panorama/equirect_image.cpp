@@ -1,0 +1,119 @@
+#include "capture/panorama/equirect_image.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/core.hpp>
+#include <stdexcept>
+
+#include "capture/image_file.h"
+#include "core/image/hdr_file.h"
+#include "core/image/srgb.h"
+#include "core/scene/asset_error.h"
+
+namespace arpipe {
+namespace {
+
+bool has_extension(const std::filesystem::path& file, std::initializer_list<const char*> extensions) {
+  std::string ext = file.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return std::find(extensions.begin(), extensions.end(), ext) != extensions.end();
+}
+
+std::string shape_problem(int width, int height) {
+  if (width <= 0 || height <= 0) return fmt::format("an empty image ({} x {})", width, height);
+  if (width != 2 * height) return fmt::format("{} x {} is not 2:1, as an equirectangular panorama is", width, height);
+  if (height % 2 != 0) return fmt::format("{} x {}: the height must be even", width, height);
+  if (width > EquirectImage::kMaxWidth)
+    return fmt::format("{} x {} is wider than the limit of {} pixels", width, height, EquirectImage::kMaxWidth);
+  return {};
+}
+
+}  // namespace
+
+EquirectImage::EquirectImage(std::vector<uint8_t> rgb, int width, int height, std::string name) : name_(std::move(name)) {
+  if (const std::string why = shape_problem(width, height); !why.empty())
+    throw std::invalid_argument(fmt::format("panorama \"{}\": {}", name_, why));
+  if (rgb.size() != size_t(width) * size_t(height) * 3)
+    throw std::invalid_argument(fmt::format("panorama \"{}\": {} bytes for {} x {} RGB", name_, rgb.size(), width, height));
+  levels_.push_back({width, height, std::move(rgb)});
+  // Each level the 2 x 2 mean of the one above, while both sides stay even (so that half a turn is
+  // a whole number of texels) and above the smallest height.
+  while (levels_.back().height % 2 == 0 && levels_.back().height / 2 >= kMaxSmallestLevelHeight) {
+    const Level& above = levels_.back();
+    Level next{above.width / 2, above.height / 2, {}};
+    next.rgb.resize(size_t(next.width) * size_t(next.height) * 3);
+    for (int y = 0; y < next.height; ++y)
+      for (int x = 0; x < next.width; ++x)
+        for (int c = 0; c < 3; ++c) {
+          const auto at = [&](int dx, int dy) {
+            return int(above.rgb[(size_t(2 * y + dy) * size_t(above.width) + size_t(2 * x + dx)) * 3 + size_t(c)]);
+          };
+          next.rgb[(size_t(y) * size_t(next.width) + size_t(x)) * 3 + size_t(c)] =
+              static_cast<uint8_t>((at(0, 0) + at(1, 0) + at(0, 1) + at(1, 1) + 2) / 4);
+        }
+    levels_.push_back(std::move(next));
+  }
+}
+
+EquirectImage EquirectImage::load(const std::filesystem::path& file, double hdr_scale) {
+  const std::string what = "panorama";
+  if (has_extension(file, {".hdr", ".exr"})) {
+    const HdrImage hdr = read_hdr_image(file);
+    if (const std::string why = shape_problem(hdr.width, hdr.height); !why.empty())
+      throw AssetError(fmt::format("{} \"{}\": {}", what, file.string(), why));
+    std::vector<uint8_t> rgb(hdr.rgb.size());
+    for (size_t i = 0; i < rgb.size(); ++i)
+      rgb[i] = static_cast<uint8_t>(std::lround(255 * srgb_encode(std::clamp(double(hdr.rgb[i]) * hdr_scale, 0.0, 1.0))));
+    return EquirectImage(std::move(rgb), hdr.width, hdr.height, file.string());
+  }
+  const ImageFileLimits limits{kMaxWidth, int64_t{kMaxWidth} * (kMaxWidth / 2), uint64_t{1} << 30};
+  const cv::Mat bgr = read_image_file(file, what, limits);
+  if (const std::string why = shape_problem(bgr.cols, bgr.rows); !why.empty())
+    throw AssetError(fmt::format("{} \"{}\": {}", what, file.string(), why));
+  std::vector<uint8_t> rgb(size_t(bgr.cols) * size_t(bgr.rows) * 3);
+  for (int y = 0; y < bgr.rows; ++y) {
+    const uint8_t* in = bgr.ptr<uint8_t>(y);
+    uint8_t* out = rgb.data() + size_t(y) * size_t(bgr.cols) * 3;
+    for (int x = 0; x < bgr.cols; ++x) {
+      out[3 * x] = in[3 * x + 2];
+      out[3 * x + 1] = in[3 * x + 1];
+      out[3 * x + 2] = in[3 * x];
+    }
+  }
+  return EquirectImage(std::move(rgb), bgr.cols, bgr.rows, file.string());
+}
+
+const uint8_t* EquirectImage::texel(int level, int x, int y) const {
+  const Level& l = levels_[static_cast<size_t>(level)];
+  // Past a pole: the row mirrored back, half a turn round.
+  if (y < 0) {
+    y = -1 - y;
+    x += l.width / 2;
+  } else if (y >= l.height) {
+    y = 2 * l.height - 1 - y;
+    x += l.width / 2;
+  }
+  y = std::clamp(y, 0, l.height - 1);  // only for positions more than a whole image past a pole
+  x %= l.width;
+  if (x < 0) x += l.width;
+  return l.rgb.data() + (size_t(y) * size_t(l.width) + size_t(x)) * 3;
+}
+
+void EquirectImage::sample(int level, float u, float v, uint8_t out[3]) const {
+  const float fu = std::floor(u), fv = std::floor(v);
+  const float ax = u - fu, ay = v - fv;
+  const int x0 = static_cast<int>(fu), y0 = static_cast<int>(fv);
+  const uint8_t* a = texel(level, x0, y0);
+  const uint8_t* b = texel(level, x0 + 1, y0);
+  const uint8_t* c = texel(level, x0, y0 + 1);
+  const uint8_t* d = texel(level, x0 + 1, y0 + 1);
+  for (int k = 0; k < 3; ++k) {
+    const float top = float(a[k]) + ax * (float(b[k]) - float(a[k]));
+    const float bottom = float(c[k]) + ax * (float(d[k]) - float(c[k]));
+    out[k] = static_cast<uint8_t>(top + ay * (bottom - top) + 0.5f);
+  }
+}
+
+}  // namespace arpipe

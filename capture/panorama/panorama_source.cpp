@@ -1,0 +1,119 @@
+#include "capture/panorama/panorama_source.h"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <mutex>
+
+#include "capture/panorama/equirect_image.h"
+#include "capture/panorama/panorama_view.h"
+#include "core/environment/hdr_environment.h"
+#include "core/log.h"
+
+namespace arpipe {
+
+SE3 panorama_view_pose(const PanoramaConfig& config, double t_s) {
+  const Mat3 R_world_cam = mat_mul(default_world_from_probe(config.yaw_rad), panorama_view_rotation_at(config, t_s));
+  const Mat3 R_cam_world = transpose(R_world_cam);
+  return SE3(R_cam_world, -1.0 * mat_mul(R_cam_world, config.position_m));
+}
+
+Mat3 panorama_view_rotation_at(const PanoramaConfig& config, double t_s) {
+  return panorama_view_rotation(config.view.yaw_rad + config.view.yaw_rad_per_s * t_s, config.view.pitch_rad);
+}
+
+struct PanoramaSource::Impl {
+  SourceConfig config;
+  std::unique_ptr<EquirectImage> panorama;
+  std::unique_ptr<PanoramaView> view;
+  int64_t interval_ns = 0;
+  uint64_t next_index = 0;
+  std::mutex mutex;
+  std::condition_variable wake;
+  bool interrupted = false;
+  bool clock_started = false;
+  std::chrono::steady_clock::time_point wall_start;
+};
+
+namespace {
+
+std::shared_ptr<const CameraModel> view_camera(const PanoramaViewConfig& view) {
+  if (!view.camera_model.empty()) return std::make_shared<const CameraModel>(CameraModel::load(view.camera_model));
+  // A pinhole of the given horizontal field of view, square pixels, centred.
+  const double fx = 0.5 * view.width / std::tan(0.5 * view.hfov_rad);
+  return std::make_shared<const CameraModel>(
+      CameraModel::pinhole(fx, fx, 0.5 * (view.width - 1), 0.5 * (view.height - 1), view.width, view.height));
+}
+
+}  // namespace
+
+PanoramaSource::PanoramaSource(const SourceConfig& config) : impl_(std::make_unique<Impl>()) {
+  impl_->config = config;
+  const PanoramaConfig& panorama = config.panorama;
+  impl_->panorama = std::make_unique<EquirectImage>(EquirectImage::load(panorama.file, panorama.hdr_scale));
+  impl_->view = std::make_unique<PanoramaView>(view_camera(panorama.view));
+  impl_->interval_ns = std::llround(1e9 / panorama.view.fps);
+}
+
+PanoramaSource::~PanoramaSource() = default;
+
+std::string PanoramaSource::describe() const {
+  return fmt::format("panorama {} ({} x {}) seen {} x {}", impl_->config.panorama.file.string(), impl_->panorama->width(),
+                     impl_->panorama->height(), impl_->view->camera()->width(), impl_->view->camera()->height());
+}
+
+std::shared_ptr<const CameraModel> PanoramaSource::camera_model() const { return impl_->view->camera(); }
+
+std::optional<int64_t> PanoramaSource::frame_interval_ns() const { return impl_->interval_ns; }
+
+void PanoramaSource::interrupt() {
+  {
+    std::lock_guard lock(impl_->mutex);
+    impl_->interrupted = true;
+  }
+  impl_->wake.notify_all();
+}
+
+SourceStatus PanoramaSource::next(Frame& frame) {
+  Impl& s = *impl_;
+  const PanoramaConfig& panorama = s.config.panorama;
+  if (panorama.view.frames > 0 && s.next_index >= uint64_t(panorama.view.frames)) return SourceStatus::EndOfStream;
+  const uint64_t index = s.next_index;
+  int64_t start_ns = 0;
+  if (__builtin_mul_overflow(int64_t(index), s.interval_ns, &start_ns)) return SourceStatus::EndOfStream;
+  try {
+    if (s.config.pacing == ReplayPacing::Timestamps) {
+      std::unique_lock lock(s.mutex);
+      if (!s.clock_started) {
+        s.clock_started = true;
+        s.wall_start = std::chrono::steady_clock::now();
+      }
+      s.wake.wait_until(lock, s.wall_start + std::chrono::nanoseconds(start_ns), [&] { return s.interrupted; });
+      if (s.interrupted) {
+        s.interrupted = false;
+        return SourceStatus::Retry;
+      }
+    }
+    const double t_s = double(index) / panorama.view.fps;
+    const CameraModel& camera = *s.view->camera();
+    frame = Frame::allocate(PixelFormat::RGB24, camera.width(), camera.height());
+    s.view->render(*s.panorama, panorama_view_rotation_at(panorama, t_s), frame.data.data(), frame.bytes_per_line);
+    frame.meta = FrameMetadata{};
+    frame.meta.sequence = index;
+    frame.meta.exposure_start_ns = start_ns + s.config.timestamp_offset_ns;
+    frame.meta.raw_timestamp_ns = start_ns;
+    frame.meta.frame_duration_ns = s.interval_ns;
+    frame.meta.timestamp_offset_ns = s.config.timestamp_offset_ns;
+    frame.meta.known_T_cam_world = panorama_view_pose(panorama, t_s);
+    s.next_index = index + 1;
+    return SourceStatus::Frame;
+  } catch (const std::exception& e) {  // per-frame code never throws (docs/DESIGN.md "Errors")
+    log::error("panorama {}: frame {}: {}", panorama.file.string(), index, e.what());
+    s.next_index = index + 1;
+    return SourceStatus::Retry;
+  }
+}
+
+}  // namespace arpipe

@@ -1,0 +1,117 @@
+#include "capture/panorama/panorama_view.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace arpipe {
+namespace {
+
+constexpr float kPi = std::numbers::pi_v<float>;
+// Taps across at most, per level: past that, the next level.
+constexpr int kMaxTapsAcross = 8;
+// A pixel may span this many texels down before the next level serves it: bilinear taps then
+// still reach every texel under it.
+constexpr float kMostTexelsDown = 1.5f;
+
+std::array<float, 3> rotate(const std::array<std::array<float, 3>, 3>& R, const std::array<float, 4>& v) {
+  return {R[0][0] * v[0] + R[0][1] * v[1] + R[0][2] * v[2], R[1][0] * v[0] + R[1][1] * v[1] + R[1][2] * v[2],
+          R[2][0] * v[0] + R[2][1] * v[1] + R[2][2] * v[2]};
+}
+
+std::array<std::array<float, 3>, 3> to_float(const Mat3& m) {
+  std::array<std::array<float, 3>, 3> out{};
+  for (size_t r = 0; r < 3; ++r)
+    for (size_t c = 0; c < 3; ++c) out[r][c] = static_cast<float>(m[r][c]);
+  return out;
+}
+
+double angle_between(const Vec3& a, const Vec3& b) { return std::atan2(norm(cross(a, b)), dot(a, b)); }
+
+}  // namespace
+
+Mat3 panorama_view_rotation(double yaw_rad, double pitch_rad) {
+  const double cy = std::cos(yaw_rad), sy = std::sin(yaw_rad), cp = std::cos(pitch_rad), sp = std::sin(pitch_rad);
+  const Vec3 forward{cp * sy, sp, -cp * cy};
+  const Vec3 right{cy, 0, sy};
+  const Vec3 up = cross(right, forward);
+  return {{{right[0], -up[0], forward[0]}, {right[1], -up[1], forward[1]}, {right[2], -up[2], forward[2]}}};
+}
+
+std::array<float, 2> equirect_pixel(const std::array<float, 3>& d, int width, int height) {
+  const float longitude = std::atan2(d[0], -d[2] + 0.0f);  // + 0.0f: the poles (-0) get 0, not pi
+  const float from_up = std::atan2(std::hypot(d[0], d[2]), d[1]);
+  return {(0.5f + longitude / (2 * kPi)) * float(width) - 0.5f, from_up / kPi * float(height) - 0.5f};
+}
+
+PanoramaView::PanoramaView(std::shared_ptr<const CameraModel> camera) : camera_(std::move(camera)) {
+  const int width = camera_->width(), height = camera_->height();
+  std::vector<Vec2> pixels;
+  pixels.reserve(size_t(width) * size_t(height));
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) pixels.push_back({double(x), double(y)});
+  std::vector<Vec3> rays;
+  camera_->unproject(pixels, rays);
+  const auto ray = [&](int x, int y) -> const Vec3& { return rays[size_t(y) * size_t(width) + size_t(x)]; };
+  for (size_t i = 0; i < rays.size(); ++i)
+    if (!std::isfinite(rays[i][0]) || !std::isfinite(rays[i][1]) || !std::isfinite(rays[i][2]))
+      throw CameraModelError(fmt::format("the panorama's view camera ({}) cannot unproject pixel ({}, {})",
+                                         camera_->lensmodel(), i % size_t(width), i / size_t(width)));
+  rays_.resize(rays.size());
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const Vec3 r = normalized(ray(x, y));
+      const double across = angle_between(r, ray(x + 1 < width ? x + 1 : x - 1, y));
+      const double down = angle_between(r, ray(x, y + 1 < height ? y + 1 : y - 1));
+      rays_[size_t(y) * size_t(width) + size_t(x)] = {float(r[0]), float(r[1]), float(r[2]), float(std::max(across, down))};
+    }
+}
+
+void PanoramaView::lookup_positions(const EquirectImage& panorama, const Mat3& R_pano_cam,
+                                    std::vector<std::array<float, 2>>& out) const {
+  const auto R = to_float(R_pano_cam);
+  out.resize(rays_.size());
+  for (size_t i = 0; i < rays_.size(); ++i) out[i] = equirect_pixel(rotate(R, rays_[i]), panorama.width(), panorama.height());
+}
+
+void PanoramaView::render(const EquirectImage& panorama, const Mat3& R_pano_cam, uint8_t* rgb, size_t stride) const {
+  const auto R = to_float(R_pano_cam);
+  const int width = camera_->width(), height = camera_->height();
+  const float texel_angle = kPi / float(panorama.height());  // a level-0 texel's height (and width at the equator)
+  const int last_level = panorama.levels() - 1;
+  for (int y = 0; y < height; ++y) {
+    uint8_t* row = rgb + size_t(y) * stride;
+    for (int x = 0; x < width; ++x) {
+      const std::array<float, 4>& ray = rays_[size_t(y) * size_t(width) + size_t(x)];
+      const std::array<float, 3> d = rotate(R, ray);
+      const std::array<float, 2> p = equirect_pixel(d, panorama.width(), panorama.height());
+      // The pixel's footprint in level-0 texels: down, and across (texels narrow as cos(latitude)).
+      const float tall = ray[3] / texel_angle;
+      const float wide = tall / std::max(std::hypot(d[0], d[2]), 1e-6f);
+      int level = 0;
+      while (level < last_level && (tall > kMostTexelsDown * float(1 << level) || wide > float(kMaxTapsAcross << level)))
+        ++level;
+      const float scale = 1.0f / float(1 << level);
+      const float u = (p[0] + 0.5f) * scale - 0.5f, v = (p[1] + 0.5f) * scale - 0.5f;
+      const int taps = std::clamp(static_cast<int>(std::ceil(wide * scale)), 1, kMaxTapsAcross);
+      uint8_t* out = row + 3 * size_t(x);
+      if (taps == 1) {
+        panorama.sample(level, u, v, out);
+        continue;
+      }
+      // Taps spread evenly across the footprint, averaged.
+      const float step = wide * scale / float(taps);
+      float sum[3] = {0, 0, 0};
+      for (int t = 0; t < taps; ++t) {
+        uint8_t s[3];
+        panorama.sample(level, u + (float(t) + 0.5f) * step - 0.5f * wide * scale, v, s);
+        for (int c = 0; c < 3; ++c) sum[c] += float(s[c]);
+      }
+      for (int c = 0; c < 3; ++c) out[c] = static_cast<uint8_t>(sum[c] / float(taps) + 0.5f);
+    }
+  }
+}
+
+}  // namespace arpipe

@@ -1,0 +1,50 @@
+// The camera that looks at a panorama: its lens (any mrcal model), where it looks at each time, and
+// the background it sees, looked up per pixel from its viewing ray (no sphere mesh: no seam, no
+// pinched poles, the same sharpness in every direction).
+//
+// Frames: the panorama's (core/environment/environment_layout.h: x right, y up, -z the image's
+// centre) and the view camera's (x right, y down, z forward). Yaw turns right about the panorama's
+// up, then pitch tilts up: yaw 0, pitch 0 look at the centre with its top up; pitch 90 at the zenith.
+#pragma once
+
+#include <array>
+#include <memory>
+#include <vector>
+
+#include "capture/panorama/equirect_image.h"
+#include "core/geometry/camera_model.h"
+#include "core/geometry/se3.h"
+#include "core/geometry/vec.h"
+
+namespace arpipe {
+
+// The view camera's axes in the panorama's frame (columns: right, down, forward).
+Mat3 panorama_view_rotation(double yaw_rad, double pitch_rad);
+
+// Pixel position (texel centres at integers) of a panorama-frame direction in an equirectangular
+// image of width x height: the float form of environment_direction_pixel, as the lookup computes it.
+std::array<float, 2> equirect_pixel(const std::array<float, 3>& d_pano, int width, int height);
+
+class PanoramaView {
+ public:
+  // Unprojects every pixel of the camera once. Throws CameraModelError when a pixel cannot be
+  // unprojected (the lens must see every pixel).
+  explicit PanoramaView(std::shared_ptr<const CameraModel> camera);
+
+  const std::shared_ptr<const CameraModel>& camera() const { return camera_; }
+
+  // Writes the background seen with the camera turned by R_pano_cam into rgb (RGB24, rows of
+  // `stride` bytes): per pixel, the ray's panorama pixel, sampled at the pyramid level and with the
+  // taps across that the pixel's footprint there needs (wider towards the poles).
+  void render(const EquirectImage& panorama, const Mat3& R_pano_cam, uint8_t* rgb, size_t stride) const;
+
+  // The level-0 panorama position each pixel's ray meets (row-major), as render computes it.
+  void lookup_positions(const EquirectImage& panorama, const Mat3& R_pano_cam, std::vector<std::array<float, 2>>& out) const;
+
+ private:
+  std::shared_ptr<const CameraModel> camera_;
+  // Per pixel: the unit ray (camera frame) and the angle to its neighbours (radians).
+  std::vector<std::array<float, 4>> rays_;
+};
+
+}  // namespace arpipe

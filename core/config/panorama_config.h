@@ -1,0 +1,74 @@
+// [source.panorama]: a 360° panorama as the background (seed 003's hybrid viewer), seen through a
+// view camera turned over time. The panorama is placed in the world as an environment image is
+// (core/environment/environment_layout.h, "equirect"; hdr_environment.h, default_world_from_probe):
+// its centre column looks along world +y, its top row is world +z, turning right moves right.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <numbers>
+
+#include "core/config/choice_names.h"
+#include "core/config/config_rules.h"
+#include "core/geometry/vec.h"
+
+namespace arpipe {
+
+// How the image holds the sphere (source.panorama.layout). Only the mono equirectangular layout
+// is built; the stereo layouts (top/bottom, left/right) are not yet.
+enum class PanoramaLayout { Equirect };
+inline constexpr ChoiceName<PanoramaLayout> kPanoramaLayoutNames[] = {{"equirect", PanoramaLayout::Equirect}};
+
+// The camera that looks at the panorama, and where it looks over time.
+struct PanoramaViewConfig {
+  std::filesystem::path camera_model;  // an mrcal .cameramodel; empty: a pinhole of width, height, hfov
+  int width = 1280;
+  int height = 720;
+  double hfov_rad = std::numbers::pi / 2;
+  double fps = 30;
+  int64_t frames = 0;                  // 0: without end
+  // Yaw 0, pitch 0 look at the panorama's centre with its top up; yaw > 0 turns right, pitch > 0 up
+  // (90: the zenith). The yaw sweeps at yaw_rad_per_s (the seed's protocol: 12 degrees/s).
+  double yaw_rad = 0;
+  double yaw_rad_per_s = 0;
+  double pitch_rad = 0;
+
+  bool operator==(const PanoramaViewConfig&) const = default;
+};
+
+template <class V>
+void visit(V& v, PanoramaViewConfig& s) {
+  v.key("camera_model", s.camera_model, "an mrcal .cameramodel for the view; \"\": a pinhole of width, height and hfov_deg");
+  v.key("width", s.width, IntRange{2, 16384}, "the view's width without camera_model");
+  v.key("height", s.height, IntRange{2, 16384}, "the view's height without camera_model");
+  v.key("hfov_deg", s.hfov_rad, Degrees{NumberRange::open_closed(0, 170)}, "the pinhole view's horizontal field of view");
+  v.key("fps", s.fps, NumberRange::open_closed(0, 1000), "frames a second (frame times are index / fps)");
+  v.key("frames", s.frames, IntRange{0, 1'000'000'000}, "frames to give; 0 = without end");
+  v.key("yaw_deg", s.yaw_rad, Degrees{NumberRange::closed(-1e6, 1e6)}, "where the first frame looks: right of the centre");
+  v.key("yaw_deg_per_s", s.yaw_rad_per_s, Degrees{NumberRange::closed(-1e5, 1e5).in("degrees/s")},
+        "the yaw's sweep (the seed's protocol: 12)");
+  v.key("pitch_deg", s.pitch_rad, Degrees{NumberRange::closed(-90, 90)}, "up from the horizon (90 = the zenith)");
+}
+
+struct PanoramaConfig {
+  std::filesystem::path file;          // a still: PNG, JPEG (8-bit sRGB), Radiance .hdr or OpenEXR .exr
+  PanoramaLayout layout = PanoramaLayout::Equirect;
+  Vec3 position_m{0, 0, 0};            // where in the world it was taken (the view camera's centre)
+  double yaw_rad = 0;                  // its turn about world z (as light.environment.yaw_deg)
+  double hdr_scale = 1;                // .hdr / .exr: the file's radiance to display values (1.0 = white)
+  PanoramaViewConfig view;
+
+  bool operator==(const PanoramaConfig&) const = default;
+};
+
+template <class V>
+void visit(V& v, PanoramaConfig& s) {
+  v.key("file", s.file, "a still: PNG or JPEG (sRGB), Radiance .hdr or OpenEXR .exr (linear, tone-clipped)");
+  v.key("layout", s.layout, kPanoramaLayoutNames, "how the image holds the sphere (equirect: 2:1, mono)");
+  v.key("position_m", s.position_m, "where in the world it was taken (the view's centre)");
+  v.key("yaw_deg", s.yaw_rad, Degrees{NumberRange::closed(-360, 360)}, "its turn about world z (0: the centre looks along +y)");
+  v.key("hdr_scale", s.hdr_scale, NumberRange::open_closed(0, 1e12), "HDR files: radiance to display value (1 = white)");
+  v.section("view", s.view, "the camera that looks at the panorama");
+}
+
+}  // namespace arpipe
