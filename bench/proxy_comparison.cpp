@@ -53,7 +53,8 @@ double first_object_motion_px(const CameraModel& camera, const ShutterMotion& mo
   return most;
 }
 
-// The layer's alpha, read back (RGBA float), zero outside the drawn footprint (stale texels).
+}  // namespace
+
 std::vector<float> layer_alpha(const VirtualLayerTexture& layer) {
   GlFramebuffer framebuffer = GlFramebuffer::create();
   glBindFramebuffer(GL_FRAMEBUFFER, framebuffer.get());
@@ -70,6 +71,8 @@ std::vector<float> layer_alpha(const VirtualLayerTexture& layer) {
     }
   return alpha;
 }
+
+namespace {
 
 double timing_ms(const FrameContext& ctx, std::string_view stage) {
   for (const StageTiming& t : ctx.timings)

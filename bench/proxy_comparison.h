@@ -10,6 +10,7 @@
 
 #include "capture/sim/ground_truth_coverage.h"
 #include "core/config/config.h"
+#include "core/pipeline/frame_context.h"
 
 namespace arpipe::bench {
 
@@ -21,6 +22,10 @@ struct EdgeError {
   double edge_length_px = 0;
 };
 EdgeError occlusion_edge_error(const std::vector<float>& drawn, const sim::CoverageImage& truth);
+
+// The virtual layer's alpha, read back (row-major, the layer's size), zero outside its rectangle.
+// Needs the render stages' GL context current.
+std::vector<float> layer_alpha(const VirtualLayerTexture& layer);
 
 struct ProxyFrame {
   double motion_px = 0;  // the largest image motion of the first object's box corners over the exposure
