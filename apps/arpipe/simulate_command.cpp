@@ -2,6 +2,7 @@
 #include <fmt/format.h>
 
 #include <cstdio>
+#include <cstring>
 #include <exception>
 #include <memory>
 #include <new>
@@ -10,7 +11,11 @@
 #include "apps/arpipe/commands.h"
 #include "apps/cli/command_line.h"
 #include "apps/cli/progress_bar.h"
+#include "capture/recording/recording_reader.h"
 #include "capture/sim/sim_scene_loader.h"
+#include "capture/sinks/output_path.h"
+#include "capture/sinks/png_encoding.h"
+#include "core/image/pixel_convert.h"
 #include "capture/sim/simulator.h"
 #include "core/log.h"
 
@@ -22,7 +27,24 @@ struct SimulateOptions {
   std::string scene_path;
   sim::SimulateOptions simulate;
   int samples = 0;  // 0: the scene's render.samples_per_pixel
+  bool png = false;  // also each frame as DIR/frame_NNNNNN.png
 };
+
+// Each frame of the recording in `dir` as dir/frame_NNNNNN.png (8-bit RGB): a still for
+// source.panorama.file when the camera is an equirectangular LENSMODEL_LONLAT, or a picture to look at.
+void write_frames_as_png(const std::filesystem::path& dir) {
+  const RecordingReader reader(dir);
+  Frame frame;
+  std::vector<uint8_t> rgb;
+  for (size_t i = 0; i < reader.frame_count(); ++i) {
+    reader.read(i, frame);
+    to_rgb24(frame, rgb);
+    const std::vector<uint8_t> png = encode_png(from_rgb24(rgb.data(), frame.width, frame.height, PixelFormat::RGB24));
+    const std::filesystem::path file = dir / fmt::format("frame_{:06d}.png", i);  // as the PNG sink names them
+    if (const int error = replace_file(file, png))
+      throw std::runtime_error(fmt::format("{}: {}", file.string(), std::strerror(error)));
+  }
+}
 
 int run_simulate(SimulateOptions& command) {
   const std::string& scene_path = command.scene_path;
@@ -50,6 +72,14 @@ int run_simulate(SimulateOptions& command) {
   } catch (const std::bad_alloc&) {
     log::error("{}: out of memory while simulating into {}", scene_path, options.out_dir.string());
     return 1;
+  }
+  if (command.png) {
+    try {
+      write_frames_as_png(options.out_dir);
+    } catch (const std::exception& e) {
+      log::error("writing the frames as PNG: {}", e.what());
+      return 1;
+    }
   }
   log::info("wrote {} frames to {} in {:.1f} s ({:.1f} s setup, {:.2f} s per frame{})", summary.frames,
             options.out_dir.string(), summary.seconds, summary.setup_seconds,
@@ -87,6 +117,7 @@ void add_simulate_command(CLI::App& arpipe) {
         }
       }, "a square number"))
       ->default_str("the scene's");
+  command->add_flag("--png", options->png, "also write each frame as DIR/frame_NNNNNN.png (a LENSMODEL_LONLAT camera's: a panorama)");
   cli::on_run(command, [options] { return run_simulate(*options); }, cli::Failure{.status = 1});
 }
 

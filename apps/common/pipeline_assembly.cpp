@@ -70,9 +70,10 @@ StageFactory make_stage_factory() {
   return [] {
     std::vector<std::unique_ptr<Stage>> stages;
     stages.push_back(std::make_unique<TagTracker>());
-    // The motion stage needs the tracker's poses.
+    // The motion stage needs the tracker's poses. A panorama's frames are instants (the still is
+    // looked up at one pose): nothing to blur.
     stages.push_back(std::make_unique<OptionalStage>(
-        [](const Config& c) { return c.track.enabled && c.motion.enabled; },
+        [](const Config& c) { return c.track.enabled && c.motion.enabled && c.source.type != SourceType::Panorama; },
         [] { return std::make_unique<MotionStage>(); }));
     // The fixed light needs no stage: the renderer takes it from the config.
     stages.push_back(std::make_unique<OptionalStage>([](const Config& c) { return c.light.source != LightSource::Fixed; },

@@ -1,0 +1,93 @@
+// End-to-end: the hybrid example as a user runs it. `arpipe simulate --png` makes the panorama of
+// configs/sim/proxies-panorama.toml, and arpiped runs configs/panorama.toml on it: every frame is
+// composited from the pose the sweep gives (none tracked, none blurred), the pose in each results
+// line is the configured sweep's, and the proxies report hiding part of the cube. Bad panorama
+// files stop the daemon at setup with the file named.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <numbers>
+
+#include "capture/panorama/panorama_source.h"
+#include "core/config/config.h"
+#include "tests/e2e/child_process.h"
+
+namespace fs = std::filesystem;
+using namespace arpipe;
+
+namespace {
+
+const fs::path kConfig = fs::path(ARPIPE_SOURCE_DIR) / "configs/panorama.toml";
+const fs::path kScene = fs::path(ARPIPE_SOURCE_DIR) / "configs/sim/proxies-panorama.toml";
+
+fs::path out_dir(const std::string& name) {
+  const fs::path dir = fs::path(ARPIPE_BINARY_DIR) / "e2e-out" / (name + "-" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+TEST(PanoramaReplay, TheHybridExampleRunsFromTheSimulatedStill) {
+  const fs::path out = out_dir("panorama");
+  std::string stderr_text;
+  ASSERT_EQ(test::run_to_exit(test::build_program("arpipe"),
+                              {"simulate", "--scene", kScene.string(), "--out", (out / "still").string(), "--png"},
+                              out / "logs-simulate", &stderr_text),
+            0)
+      << stderr_text;
+  const fs::path still = out / "still" / "frame_000000.png";
+  ASSERT_TRUE(fs::exists(still));
+  constexpr int kFrames = 6;
+  const std::vector<std::string> overrides{"source.panorama.file=\"" + still.string() + "\"",
+                                           "source.panorama.view.frames=" + std::to_string(kFrames),
+                                           "sinks.png.dir=\"" + (out / "png").string() + "\"",
+                                           "sinks.results.path=\"" + (out / "results.jsonl").string() + "\""};
+  std::vector<std::string> args{"--config", kConfig.string()};
+  for (const std::string& o : overrides) args.insert(args.end(), {"--set", o});
+  ASSERT_EQ(test::run_to_exit(test::build_program("arpiped"), args, out / "logs", &stderr_text), 0) << stderr_text;
+
+  const Config config = load_config(kConfig, overrides);
+  std::ifstream in(out / "results.jsonl");
+  int lines = 0;
+  for (std::string line; std::getline(in, line); ++lines) {
+    const nlohmann::json frame = nlohmann::json::parse(line);
+    ASSERT_TRUE(frame["virtual_layer_drawn"].get<bool>()) << line;
+    EXPECT_EQ(frame["skipped"]["track"], "pose given by the source") << line;
+    EXPECT_EQ(frame["blur"]["method"], "off") << line;
+    // The pose is the sweep's at index / fps.
+    const SE3 expected = panorama_view_pose(config.source.panorama, lines / config.source.panorama.view.fps);
+    const SE3 reported = SE3::from_rt({frame["T_cam_world"]["r"][0], frame["T_cam_world"]["r"][1], frame["T_cam_world"]["r"][2]},
+                                      {frame["T_cam_world"]["t"][0], frame["T_cam_world"]["t"][1], frame["T_cam_world"]["t"][2]});
+    const SE3 difference = expected.inverse() * reported;
+    EXPECT_LT(norm(difference.rotation_vector()), 1e-9) << line;
+    EXPECT_LT(norm(difference.translation()), 1e-9) << line;
+    // The cylinder stands in front of the cube's left half from this viewpoint.
+    const nlohmann::json& cube = frame["objects"][0];
+    EXPECT_TRUE(cube["in_view"].get<bool>()) << line;
+    EXPECT_GT(cube["hidden_by"]["cylinder"].get<double>(), 0.2) << line;
+    EXPECT_TRUE(fs::exists(out / "png" / fmt::format("frame_{:06d}.png", lines))) << lines;
+  }
+  EXPECT_EQ(lines, kFrames);
+  fs::remove_all(out);
+}
+
+TEST(PanoramaReplay, BadStillsStopTheDaemonAtSetupNamingTheFile) {
+  const fs::path out = out_dir("panorama-bad");
+  std::ofstream(out / "not-a-panorama.png") << "text, not an image\n";
+  for (const fs::path& file : {out / "not-a-panorama.png", out / "missing.png"}) {
+    std::string stderr_text;
+    const int code = test::run_to_exit(
+        test::build_program("arpiped"),
+        {"--config", kConfig.string(), "--set", "source.panorama.file=\"" + file.string() + "\"", "--set",
+         "sinks.png.dir=\"" + (out / "png").string() + "\"", "--set", "sinks.results.path=\"" + (out / "r.jsonl").string() + "\""},
+        out / "logs", &stderr_text);
+    EXPECT_NE(code, 0);
+    EXPECT_NE(stderr_text.find(file.string()), std::string::npos) << stderr_text;
+  }
+  fs::remove_all(out);
+}
+
+}  // namespace
