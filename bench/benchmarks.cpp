@@ -20,6 +20,7 @@ void add_benchmarks(CLI::App& bench) {
   add_prt_benchmark(bench);
   add_physics_benchmark(bench);
   add_proxies_benchmark(bench);
+  add_panorama_benchmark(bench);
 }
 
 }  // namespace arpipe

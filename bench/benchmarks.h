@@ -26,5 +26,6 @@ void add_sh_benchmark(CLI::App& bench);             // sh: spherical-harmonic er
 void add_prt_benchmark(CLI::App& bench);            // prt: PRT bake time against error, run-time cost (prt_bake_accuracy.cpp)
 void add_physics_benchmark(CLI::App& bench);        // physics: time per frame against bounce error, per substep rate (physics_cost.cpp)
 void add_proxies_benchmark(CLI::App& bench);        // proxies: render time against occlusion edge error, full and simplified (proxies_cost.cpp)
+void add_panorama_benchmark(CLI::App& bench);       // panorama: the 360° background's lookup, time against error (panorama_lookup.cpp)
 
 }  // namespace arpipe

@@ -101,19 +101,5 @@ const uint8_t* EquirectImage::texel(int level, int x, int y) const {
   return l.rgb.data() + (size_t(y) * size_t(l.width) + size_t(x)) * 3;
 }
 
-void EquirectImage::sample(int level, float u, float v, uint8_t out[3]) const {
-  const float fu = std::floor(u), fv = std::floor(v);
-  const float ax = u - fu, ay = v - fv;
-  const int x0 = static_cast<int>(fu), y0 = static_cast<int>(fv);
-  const uint8_t* a = texel(level, x0, y0);
-  const uint8_t* b = texel(level, x0 + 1, y0);
-  const uint8_t* c = texel(level, x0, y0 + 1);
-  const uint8_t* d = texel(level, x0 + 1, y0 + 1);
-  for (int k = 0; k < 3; ++k) {
-    const float top = float(a[k]) + ax * (float(b[k]) - float(a[k]));
-    const float bottom = float(c[k]) + ax * (float(d[k]) - float(c[k]));
-    out[k] = static_cast<uint8_t>(top + ay * (bottom - top) + 0.5f);
-  }
-}
 
 }  // namespace arpipe

@@ -4,6 +4,7 @@
 // half a turn round), so no direction has a seam or a pinch.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -32,7 +33,7 @@ class EquirectImage {
 
   // The bilinear sample at pixel position (u, v) of `level` (texel centres at integers, so level
   // 0 spans [-0.5, width - 0.5)), folded across the seam and the poles, rounded to 8 bits.
-  void sample(int level, float u, float v, uint8_t out[3]) const;
+  inline void sample(int level, float u, float v, uint8_t out[3]) const;  // inline: the lookup's inner loop
   // The texel (x, y) of `level` after folding (any integers).
   const uint8_t* texel(int level, int x, int y) const;
 
@@ -45,5 +46,29 @@ class EquirectImage {
   std::vector<Level> levels_;
   std::string name_;
 };
+
+inline void EquirectImage::sample(int level, float u, float v, uint8_t out[3]) const {
+  const float fu = std::floor(u), fv = std::floor(v);
+  const float ax = u - fu, ay = v - fv;
+  const int x0 = static_cast<int>(fu), y0 = static_cast<int>(fv);
+  const Level& l = levels_[static_cast<size_t>(level)];
+  const uint8_t *a, *b, *c, *d;
+  if (x0 >= 0 && y0 >= 0 && x0 + 1 < l.width && y0 + 1 < l.height) {  // nothing to fold: most taps
+    a = l.rgb.data() + (size_t(y0) * size_t(l.width) + size_t(x0)) * 3;
+    b = a + 3;
+    c = a + size_t(l.width) * 3;
+    d = c + 3;
+  } else {
+    a = texel(level, x0, y0);
+    b = texel(level, x0 + 1, y0);
+    c = texel(level, x0, y0 + 1);
+    d = texel(level, x0 + 1, y0 + 1);
+  }
+  for (int k = 0; k < 3; ++k) {
+    const float top = float(a[k]) + ax * (float(b[k]) - float(a[k]));
+    const float bottom = float(c[k]) + ax * (float(d[k]) - float(c[k]));
+    out[k] = static_cast<uint8_t>(top + ay * (bottom - top) + 0.5f);
+  }
+}
 
 }  // namespace arpipe

@@ -1,0 +1,129 @@
+// Benchmark: the panorama source's per-pixel background lookup (capture/panorama/panorama_view.h),
+// time against error. `arpipe bench panorama [--frames N] [--size WxH]`
+// For views of 640x480, 1280x720 and 1920x1080 (90 degrees across) of a WxH panorama (4096x2048 by
+// default) at the horizon, 60 degrees up and at the zenith, prints ms per frame (the median frame), the same against
+// a memcpy of the frame (measured in the same run), and the looked-up positions' error against a
+// double-precision remap (mrcal's unprojection, the rotation, environment_direction_pixel), as an
+// angle in texels: mean and largest over the frames' pixels.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <memory>
+#include <numbers>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "apps/cli/command_line.h"
+#include "bench/benchmarks.h"
+#include "capture/panorama/equirect_image.h"
+#include "capture/panorama/panorama_view.h"
+#include "core/environment/environment_layout.h"
+
+namespace arpipe {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+double median(std::vector<double> values) {
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return values[values.size() / 2];
+}
+
+// A panorama with detail at every scale: smooth colour plus texel noise.
+EquirectImage test_panorama(int width, int height) {
+  std::vector<uint8_t> rgb(size_t(width) * size_t(height) * 3);
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> noise(-20, 20);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const Vec3 d = *environment_pixel_direction(EnvironmentLayout::Equirectangular, width, height, x, y);
+      for (size_t c = 0; c < 3; ++c)
+        rgb[(size_t(y) * size_t(width) + size_t(x)) * 3 + c] =
+            uint8_t(std::clamp(128 + int(90 * d[c]) + noise(rng), 0, 255));
+    }
+  return EquirectImage(std::move(rgb), width, height, "benchmark panorama");
+}
+
+struct Row {
+  int width, height;
+  double pitch_deg;
+  double lookup_ms, memcpy_ms, mean_texels, max_texels;
+};
+
+// Frames at one pitch, the yaw a golden turn further each frame.
+Row measure(const EquirectImage& panorama, int width, int height, double pitch_deg, int frames) {
+  const double fx = 0.5 * width;  // 90 degrees across
+  const auto camera =
+      std::make_shared<const CameraModel>(CameraModel::pinhole(fx, fx, 0.5 * (width - 1), 0.5 * (height - 1), width, height));
+  const PanoramaView view(camera);
+  std::vector<uint8_t> out(size_t(width) * size_t(height) * 3), copy(out.size());
+  std::vector<double> lookup_ms, memcpy_ms;
+  double error_sum = 0, error_max = 0;
+  size_t error_count = 0;
+  std::vector<std::array<float, 2>> positions;
+  for (int f = 0; f < frames; ++f) {
+    const Mat3 R = panorama_view_rotation(f * 2.399963, pitch_deg * kPi / 180);
+    auto start = std::chrono::steady_clock::now();
+    view.render(panorama, R, out.data(), size_t(width) * 3);
+    lookup_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+    start = std::chrono::steady_clock::now();
+    std::memcpy(copy.data(), out.data(), out.size());
+    memcpy_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+    // The positions against double precision, on every 7th pixel.
+    view.lookup_positions(panorama, R, positions);
+    for (size_t i = 0; i < positions.size(); i += 7) {
+      const Vec3 ray = normalized(*camera->unproject({double(i % size_t(width)), double(i / size_t(width))}));
+      const Vec3 truth = mat_mul(R, ray);
+      const Vec3 looked = *environment_pixel_direction(EnvironmentLayout::Equirectangular, panorama.width(),
+                                                       panorama.height(), positions[i][0], positions[i][1]);
+      const double texels = std::atan2(norm(cross(truth, looked)), dot(truth, looked)) / (kPi / panorama.height());
+      error_sum += texels;
+      error_max = std::max(error_max, texels);
+      ++error_count;
+    }
+  }
+  return {width, height, pitch_deg, median(lookup_ms), median(memcpy_ms), error_sum / double(error_count), error_max};
+}
+
+int run_panorama_benchmark(int frames, int width, int height) {
+  const EquirectImage panorama = test_panorama(width, height);
+  fmt::print("panorama {} x {} ({} pyramid levels), {} frames a row, the yaw a golden turn further each frame\n\n", width,
+             height, panorama.levels(), frames);
+  fmt::print("| view | pitch | lookup ms/frame (median) | memcpy of the frame, ms | lookup / memcpy | mean error, texels | max error, texels |\n");
+  fmt::print("|---|---:|---:|---:|---:|---:|---:|\n");
+  for (const auto& [w, h] : std::vector<std::pair<int, int>>{{640, 480}, {1280, 720}, {1920, 1080}})
+    for (const double pitch : {0.0, 60.0, 90.0}) {
+      const Row row = measure(panorama, w, h, pitch, frames);
+      fmt::print("| {}x{} | {:.0f} | {:.2f} | {:.3f} | {:.0f} | {:.5f} | {:.4f} |\n", row.width, row.height, row.pitch_deg,
+                 row.lookup_ms, row.memcpy_ms, row.lookup_ms / row.memcpy_ms, row.mean_texels, row.max_texels);
+    }
+  return 0;
+}
+
+}  // namespace
+
+void add_panorama_benchmark(CLI::App& bench) {
+  CLI::App* command = bench.add_subcommand(
+      "panorama", "the panorama source's per-pixel background lookup: ms per frame against its error in texels");
+  struct Options {
+    int frames = 10;
+    std::string size = "4096x2048";
+  };
+  auto options = std::make_shared<Options>();
+  command->add_option("--frames", options->frames, "frames a row")->check(CLI::PositiveNumber);
+  command->add_option("--size", options->size, "the panorama's size, WxH (2:1, even height)")->type_name("WxH");
+  cli::on_run(command, [options] {
+    int width = 0, height = 0;
+    if (std::sscanf(options->size.c_str(), "%dx%d", &width, &height) != 2 || width != 2 * height || height % 2 != 0 ||
+        width > EquirectImage::kMaxWidth || height < 2)
+      throw std::invalid_argument(fmt::format("--size {}: expected WxH with W = 2 H, H even, W at most {}", options->size,
+                                              EquirectImage::kMaxWidth));
+    return run_panorama_benchmark(options->frames, width, height);
+  }, cli::Failure{});
+}
+
+}  // namespace arpipe
