@@ -20,6 +20,7 @@ pkg_check_modules(OPENEXR REQUIRED IMPORTED_TARGET OpenEXR)  # HDR light probes 
 pkg_check_modules(XXHASH REQUIRED IMPORTED_TARGET libxxhash)  # the PRT cache key: a hash of the mesh content
 pkg_check_modules(MICROHTTPD REQUIRED IMPORTED_TARGET libmicrohttpd)  # the live HTTP outputs (preview, MJPEG, metrics)
 pkg_check_modules(GSTREAMER REQUIRED IMPORTED_TARGET gstreamer-1.0 gstreamer-app-1.0)  # sinks.gstreamer: files, RTSP, encoders
+pkg_check_modules(FFMPEG REQUIRED IMPORTED_TARGET libavformat libavcodec libswscale libavutil)  # panorama videos
 
 # mrcal ships no pkg-config or CMake file; -lmrcal pulls in libdogleg and CHOLMOD.
 find_library(MRCAL_LIBRARY mrcal REQUIRED)

@@ -40,6 +40,9 @@ struct FrameMetadata {
   // camera, turned by its configured sweep): T_cam_world at exposure_mid_ns. The track stage then
   // takes it instead of detecting tags.
   std::optional<SE3> known_T_cam_world;
+  // The index of the source's own frame this one shows, when that differs from the sequence: a
+  // panorama video's frame (in presentation order), which repeats on each loop.
+  std::optional<int64_t> source_frame_index;
 
   // Middle of the exposure of the middle row: where a single pose for the frame belongs.
   int64_t exposure_mid_ns() const { return exposure_start_ns + (exposure_ns + readout_ns) / 2; }

@@ -24,6 +24,8 @@ packages=(
   # live outputs: the GStreamer sink (files, RTSP, encoders) with the common elements
   libgstreamer1.0-dev libgstreamer-plugins-base1.0-dev gstreamer1.0-plugins-base
   gstreamer1.0-plugins-good gstreamer1.0-plugins-ugly gstreamer1.0-rtsp
+  # 360-degree video backgrounds: FFmpeg's demuxers, decoders and scaler
+  libavformat-dev libavcodec-dev libswscale-dev libavutil-dev
   # render: EGL + GLES 3 on Mesa (llvmpipe when there is no GPU)
   libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri libgbm1
   libtinygltf-dev libembree-dev libstb-dev libpng-dev

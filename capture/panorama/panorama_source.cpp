@@ -2,15 +2,18 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
 #include <mutex>
 
 #include "capture/panorama/equirect_image.h"
+#include "capture/panorama/panorama_video.h"
 #include "capture/panorama/panorama_view.h"
 #include "core/environment/hdr_environment.h"
 #include "core/log.h"
+#include "core/scene/asset_error.h"
 
 namespace arpipe {
 
@@ -26,7 +29,17 @@ Mat3 panorama_view_rotation_at(const PanoramaConfig& config, double t_s) {
 
 struct PanoramaSource::Impl {
   SourceConfig config;
-  std::unique_ptr<EquirectImage> panorama;
+  std::unique_ptr<EquirectImage> panorama;  // the still, or the video frame shown
+  // A video: the frame shown (its index and time), the one after it, and the loop's passes.
+  std::unique_ptr<PanoramaVideo> video;
+  PanoramaVideoFrame shown, upcoming;
+  bool has_upcoming = false;
+  int64_t loop_offset_ns = 0;  // the durations of the passes done
+  int64_t video_frame_ns = 0;  // one frame at the video's nominal rate
+
+  // Makes `shown` the video frame on screen at output time t_ns, looping (a frame is on screen from
+  // its presentation time to the next one's; the last one for one frame time).
+  void show_video_at(int64_t t_ns);
   std::unique_ptr<PanoramaView> view;
   int64_t interval_ns = 0;
   uint64_t next_index = 0;
@@ -49,10 +62,45 @@ std::shared_ptr<const CameraModel> view_camera(const PanoramaViewConfig& view) {
 
 }  // namespace
 
+void PanoramaSource::Impl::show_video_at(int64_t t_ns) {
+  const auto fetch = [&] { has_upcoming = video->next(upcoming); };
+  bool changed = false;
+  for (;;) {
+    while (has_upcoming && upcoming.time_ns <= t_ns - loop_offset_ns) {
+      std::swap(shown, upcoming);
+      changed = true;
+      fetch();
+    }
+    if (has_upcoming) break;
+    // The stream ended: the last frame lasts one frame time, then the video starts again.
+    const int64_t period = shown.time_ns + video_frame_ns;
+    if (t_ns - loop_offset_ns < period) break;
+    loop_offset_ns += period;
+    video->seek(0);
+    fetch();
+    if (!has_upcoming) throw std::runtime_error("no frame after seeking to the start");
+  }
+  if (changed || !panorama)
+    panorama = std::make_unique<EquirectImage>(std::move(shown.rgb), shown.width, shown.height, config.panorama.file.string());
+  // EquirectImage took the pixels: keep the size for the next swap.
+  shown.rgb.clear();
+}
+
 PanoramaSource::PanoramaSource(const SourceConfig& config) : impl_(std::make_unique<Impl>()) {
   impl_->config = config;
   const PanoramaConfig& panorama = config.panorama;
-  impl_->panorama = std::make_unique<EquirectImage>(EquirectImage::load(panorama.file, panorama.hdr_scale));
+  if (is_panorama_video_file(panorama.file)) {
+    Impl& s = *impl_;
+    s.video = std::make_unique<PanoramaVideo>(panorama.file);
+    s.video_frame_ns = std::max<int64_t>(1, (1'000'000'000 * s.video->rate_den() + s.video->rate_num() / 2) / s.video->rate_num());
+    if (!s.video->next(s.shown))
+      throw AssetError(fmt::format("panorama video \"{}\": no frame decodes", panorama.file.string()));
+    s.has_upcoming = s.video->next(s.upcoming);
+    s.panorama = std::make_unique<EquirectImage>(std::move(s.shown.rgb), s.shown.width, s.shown.height, panorama.file.string());
+    s.shown.rgb.clear();
+  } else {
+    impl_->panorama = std::make_unique<EquirectImage>(EquirectImage::load(panorama.file, panorama.hdr_scale));
+  }
   impl_->view = std::make_unique<PanoramaView>(view_camera(panorama.view));
   impl_->interval_ns = std::llround(1e9 / panorama.view.fps);
 }
@@ -60,8 +108,9 @@ PanoramaSource::PanoramaSource(const SourceConfig& config) : impl_(std::make_uni
 PanoramaSource::~PanoramaSource() = default;
 
 std::string PanoramaSource::describe() const {
-  return fmt::format("panorama {} ({} x {}) seen {} x {}", impl_->config.panorama.file.string(), impl_->panorama->width(),
-                     impl_->panorama->height(), impl_->view->camera()->width(), impl_->view->camera()->height());
+  return fmt::format("panorama {} ({}) seen {} x {}", impl_->config.panorama.file.string(),
+                     impl_->video ? impl_->video->describe() : fmt::format("{} x {}", impl_->panorama->width(), impl_->panorama->height()),
+                     impl_->view->camera()->width(), impl_->view->camera()->height());
 }
 
 std::shared_ptr<const CameraModel> PanoramaSource::camera_model() const { return impl_->view->camera(); }
@@ -97,6 +146,7 @@ SourceStatus PanoramaSource::next(Frame& frame) {
       }
     }
     const double t_s = double(index) / panorama.view.fps;
+    if (s.video) s.show_video_at(start_ns);
     const CameraModel& camera = *s.view->camera();
     frame = Frame::allocate(PixelFormat::RGB24, camera.width(), camera.height());
     s.view->render(*s.panorama, panorama_view_rotation_at(panorama, t_s), frame.data.data(), frame.bytes_per_line);
@@ -107,6 +157,7 @@ SourceStatus PanoramaSource::next(Frame& frame) {
     frame.meta.frame_duration_ns = s.interval_ns;
     frame.meta.timestamp_offset_ns = s.config.timestamp_offset_ns;
     frame.meta.known_T_cam_world = panorama_view_pose(panorama, t_s);
+    if (s.video) frame.meta.source_frame_index = s.shown.index;
     s.next_index = index + 1;
     return SourceStatus::Frame;
   } catch (const std::exception& e) {  // per-frame code never throws (docs/DESIGN.md "Errors")

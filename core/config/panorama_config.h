@@ -51,7 +51,9 @@ void visit(V& v, PanoramaViewConfig& s) {
 }
 
 struct PanoramaConfig {
-  std::filesystem::path file;          // a still: PNG, JPEG (8-bit sRGB), Radiance .hdr or OpenEXR .exr
+  // A still: PNG, JPEG (8-bit sRGB), Radiance .hdr or OpenEXR .exr; or a video (.mp4, .m4v, .mov,
+  // .mkv, .webm: H.264, HEVC, VP8, VP9, AV1), looped.
+  std::filesystem::path file;
   PanoramaLayout layout = PanoramaLayout::Equirect;
   Vec3 position_m{0, 0, 0};            // where in the world it was taken (the view camera's centre)
   double yaw_rad = 0;                  // its turn about world z (as light.environment.yaw_deg)
@@ -63,7 +65,7 @@ struct PanoramaConfig {
 
 template <class V>
 void visit(V& v, PanoramaConfig& s) {
-  v.key("file", s.file, "a still: PNG or JPEG (sRGB), Radiance .hdr or OpenEXR .exr (linear, tone-clipped)");
+  v.key("file", s.file, "a still (PNG, JPEG, .hdr, .exr) or a looped video (.mp4, .mov, .mkv, .webm: H.264, HEVC, VP8, VP9, AV1)");
   v.key("layout", s.layout, kPanoramaLayoutNames, "how the image holds the sphere (equirect: 2:1, mono)");
   v.key("position_m", s.position_m, "where in the world it was taken (the view's centre)");
   v.key("yaw_deg", s.yaw_rad, Degrees{NumberRange::closed(-360, 360)}, "its turn about world z (0: the centre looks along +y)");

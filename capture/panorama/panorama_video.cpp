@@ -1,0 +1,193 @@
+#include "capture/panorama/panorama_video.h"
+
+extern "C" {
+#include <libavcodec/avcodec.h>
+#include <libavformat/avformat.h>
+#include <libavutil/imgutils.h>
+#include <libswscale/swscale.h>
+}
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <string>
+
+#include "capture/panorama/equirect_image.h"
+#include "core/log.h"
+#include "core/scene/asset_error.h"
+
+namespace arpipe {
+namespace {
+
+constexpr const char* kDemuxers = "mov,mp4,m4a,3gp,3g2,mj2,matroska,webm";
+constexpr const char* kDecoders = "h264,hevc,vp8,vp9,av1,libdav1d,libaom-av1";
+
+std::string av_error(int code) {
+  char text[AV_ERROR_MAX_STRING_SIZE] = {};
+  av_strerror(code, text, sizeof text);
+  return text;
+}
+
+}  // namespace
+
+bool is_panorama_video_file(const std::filesystem::path& file) {
+  std::string ext = file.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext == ".mp4" || ext == ".m4v" || ext == ".mov" || ext == ".mkv" || ext == ".webm";
+}
+
+struct PanoramaVideo::Impl {
+  std::filesystem::path file;
+  AVFormatContext* format = nullptr;
+  AVCodecContext* codec = nullptr;
+  SwsContext* scaler = nullptr;
+  AVPacket* packet = nullptr;
+  AVFrame* frame = nullptr;
+  int stream = -1;
+  AVRational time_base{0, 1};
+  AVRational rate{0, 1};
+  int64_t start_pts = 0;
+  bool draining = false;   // the demuxer ended: the decoder is being flushed
+  bool ended = false;
+  int64_t skip_before = -1;  // after a seek: frames before this index are decoded but not given
+  uint64_t decode_errors = 0;
+
+  ~Impl() {
+    sws_freeContext(scaler);
+    av_frame_free(&frame);
+    av_packet_free(&packet);
+    avcodec_free_context(&codec);
+    avformat_close_input(&format);
+  }
+
+  [[noreturn]] void fail(const std::string& why) const {
+    throw AssetError(fmt::format("panorama video \"{}\": {}", file.string(), why));
+  }
+
+  int64_t index_of(int64_t pts) const {
+    // (pts - start) x time_base x rate, rounded to the nearest frame.
+    return av_rescale_q_rnd(pts - start_pts, time_base, av_inv_q(rate),
+                            static_cast<AVRounding>(AV_ROUND_NEAR_INF | AV_ROUND_PASS_MINMAX));
+  }
+
+  // Fills `out` from the decoded `frame`.
+  void convert(PanoramaVideoFrame& out, int64_t pts) {
+    const int w = frame->width, h = frame->height;
+    if (w != codec->width || h != codec->height) fail(fmt::format("the frame size changed to {} x {} mid-stream", w, h));
+    scaler = sws_getCachedContext(scaler, w, h, static_cast<AVPixelFormat>(frame->format), w, h, AV_PIX_FMT_RGB24,
+                                  SWS_POINT, nullptr, nullptr, nullptr);
+    if (!scaler) fail("no conversion from its pixel format to RGB");
+    out.width = w;
+    out.height = h;
+    out.rgb.resize(size_t(w) * size_t(h) * 3);
+    uint8_t* planes[1] = {out.rgb.data()};
+    const int strides[1] = {w * 3};
+    sws_scale(scaler, frame->data, frame->linesize, 0, h, planes, strides);
+    out.index = index_of(pts);
+    out.time_ns = av_rescale_q(pts - start_pts, time_base, AVRational{1, 1'000'000'000});
+  }
+};
+
+PanoramaVideo::PanoramaVideo(const std::filesystem::path& file) : impl_(std::make_unique<Impl>()) {
+  Impl& s = *impl_;
+  s.file = file;
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec)) s.fail("no such file (or not a regular file)");
+  AVDictionary* options = nullptr;
+  av_dict_set(&options, "protocol_whitelist", "file", 0);
+  s.format = avformat_alloc_context();
+  if (!s.format) s.fail("out of memory");
+  s.format->format_whitelist = av_strdup(kDemuxers);
+  s.format->codec_whitelist = av_strdup(kDecoders);
+  int error = avformat_open_input(&s.format, file.c_str(), nullptr, &options);
+  av_dict_free(&options);
+  if (error < 0) {
+    s.format = nullptr;  // freed by avformat_open_input
+    s.fail(fmt::format("cannot open it as MP4, MOV, MKV or WebM: {}", av_error(error)));
+  }
+  if ((error = avformat_find_stream_info(s.format, nullptr)) < 0) s.fail(fmt::format("no stream information: {}", av_error(error)));
+  const AVCodec* decoder = nullptr;
+  s.stream = av_find_best_stream(s.format, AVMEDIA_TYPE_VIDEO, -1, -1, &decoder, 0);
+  if (s.stream < 0 || !decoder) s.fail("no video stream that H.264, HEVC, VP8, VP9 or AV1 decoding reads");
+  AVStream* stream = s.format->streams[s.stream];
+  const AVCodecParameters* parameters = stream->codecpar;
+  const int width = parameters->width, height = parameters->height;
+  if (width != 2 * height || height <= 0 || height % 2 != 0 || width > EquirectImage::kMaxWidth)
+    s.fail(fmt::format("{} x {} is not a panorama (2:1, even height, at most {} across)", width, height, EquirectImage::kMaxWidth));
+  s.codec = avcodec_alloc_context3(decoder);
+  if (!s.codec || avcodec_parameters_to_context(s.codec, parameters) < 0) s.fail("cannot set up its decoder");
+  s.codec->thread_count = 0;  // FFmpeg's choice: one per core
+  if ((error = avcodec_open2(s.codec, decoder, nullptr)) < 0) s.fail(fmt::format("cannot open its {} decoder: {}", decoder->name, av_error(error)));
+  s.time_base = stream->time_base;
+  s.rate = stream->avg_frame_rate.num > 0 && stream->avg_frame_rate.den > 0 ? stream->avg_frame_rate : stream->r_frame_rate;
+  if (s.rate.num <= 0 || s.rate.den <= 0 || s.time_base.num <= 0 || s.time_base.den <= 0) s.fail("no frame rate or time base");
+  s.start_pts = stream->start_time != AV_NOPTS_VALUE ? stream->start_time : 0;
+  s.packet = av_packet_alloc();
+  s.frame = av_frame_alloc();
+  if (!s.packet || !s.frame) s.fail("out of memory");
+}
+
+PanoramaVideo::~PanoramaVideo() = default;
+
+int PanoramaVideo::width() const { return impl_->codec->width; }
+int PanoramaVideo::height() const { return impl_->codec->height; }
+int64_t PanoramaVideo::rate_num() const { return impl_->rate.num; }
+int64_t PanoramaVideo::rate_den() const { return impl_->rate.den; }
+uint64_t PanoramaVideo::decode_errors() const { return impl_->decode_errors; }
+
+std::string PanoramaVideo::describe() const {
+  return fmt::format("{} {} x {} at {}/{} frames/s", impl_->codec->codec->name, width(), height(), impl_->rate.num, impl_->rate.den);
+}
+
+bool PanoramaVideo::next(PanoramaVideoFrame& out) {
+  Impl& s = *impl_;
+  while (!s.ended) {
+    const int received = avcodec_receive_frame(s.codec, s.frame);
+    if (received == 0) {
+      const int64_t pts = s.frame->best_effort_timestamp;
+      if (pts == AV_NOPTS_VALUE) {  // a frame with no time cannot have an index
+        ++s.decode_errors;
+        continue;
+      }
+      if (s.skip_before >= 0 && s.index_of(pts) < s.skip_before) continue;
+      s.skip_before = -1;
+      s.convert(out, pts);
+      av_frame_unref(s.frame);
+      return true;
+    }
+    if (received == AVERROR_EOF) {
+      s.ended = true;
+      break;
+    }
+    if (received != AVERROR(EAGAIN)) {
+      ++s.decode_errors;
+      log::debug("panorama video {}: {}", s.file.string(), av_error(received));
+    }
+    if (s.draining) {
+      if (received == AVERROR(EAGAIN)) s.ended = true;
+      continue;
+    }
+    // Feed the decoder the next packet of the stream, or the flush at the end.
+    const int read = av_read_frame(s.format, s.packet);
+    if (read < 0) {
+      s.draining = true;
+      avcodec_send_packet(s.codec, nullptr);
+      continue;
+    }
+    if (s.packet->stream_index == s.stream && avcodec_send_packet(s.codec, s.packet) < 0) ++s.decode_errors;
+    av_packet_unref(s.packet);
+  }
+  return false;
+}
+
+void PanoramaVideo::seek(int64_t index) {
+  Impl& s = *impl_;
+  const int64_t target = s.start_pts + av_rescale_q(std::max<int64_t>(index, 0), av_inv_q(s.rate), s.time_base);
+  const int error = av_seek_frame(s.format, s.stream, target, AVSEEK_FLAG_BACKWARD);
+  if (error < 0) s.fail(fmt::format("cannot seek to frame {}: {}", index, av_error(error)));
+  avcodec_flush_buffers(s.codec);
+  s.draining = s.ended = false;
+  s.skip_before = std::max<int64_t>(index, 0);
+}
+
+}  // namespace arpipe

@@ -1,0 +1,197 @@
+// Panorama videos: every frame's index from its presentation time equals the index drawn into it
+// (a barcode), through B-frames and an MP4 edit list (x264), in WebM (VP9), after 100 random seeks
+// and over a 10-minute loop; bad files refused with their name. The videos are made here with
+// Debian's ffmpeg command from raw frames.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <random>
+
+#include "capture/panorama/panorama_source.h"
+#include "capture/panorama/panorama_video.h"
+#include "core/scene/asset_error.h"
+#include "tests/capture/capture_test_support.h"
+
+namespace arpipe {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr int kWidth = 256, kHeight = 128, kBits = 12;
+
+// Frame i: grey, with bit b of i as a 16 x 64 block (white 1, black 0) at column 16 b.
+std::vector<uint8_t> barcode_frame(int i) {
+  std::vector<uint8_t> rgb(size_t(kWidth) * kHeight * 3, 128);
+  for (int b = 0; b < kBits; ++b)
+    for (int y = 32; y < 96; ++y)
+      for (int x = 16 * b; x < 16 * b + 16; ++x)
+        for (int c = 0; c < 3; ++c) rgb[(size_t(y) * kWidth + size_t(x)) * 3 + size_t(c)] = (i >> b) & 1 ? 255 : 0;
+  return rgb;
+}
+
+int read_barcode(const PanoramaVideoFrame& frame) {
+  int i = 0;
+  for (int b = 0; b < kBits; ++b)
+    if (frame.rgb[(size_t(64) * size_t(frame.width) + size_t(16 * b + 8)) * 3] > 128) i |= 1 << b;
+  return i;
+}
+
+// Encodes `frames` barcoded frames at 30 frames/s with ffmpeg's arguments `codec`.
+fs::path make_video(const fs::path& dir, const std::string& name, int frames, const std::string& codec) {
+  const fs::path raw = dir / (name + ".rgb"), out = dir / name;
+  {
+    std::ofstream file(raw, std::ios::binary);
+    for (int i = 0; i < frames; ++i) {
+      const std::vector<uint8_t> rgb = barcode_frame(i);
+      file.write(reinterpret_cast<const char*>(rgb.data()), std::streamsize(rgb.size()));
+    }
+  }
+  const std::string command = fmt::format(
+      "ffmpeg -nostdin -v error -y -f rawvideo -pix_fmt rgb24 -s {}x{} -r 30 -i '{}' {} -pix_fmt yuv420p '{}'", kWidth,
+      kHeight, raw.string(), codec, out.string());
+  EXPECT_EQ(std::system(command.c_str()), 0) << command;
+  fs::remove(raw);
+  return out;
+}
+
+const fs::path& h264_with_b_frames() {
+  static const fs::path file =
+      make_video(test::scratch_dir("panorama-video"), "b-frames.mp4", 64, "-c:v libx264 -preset veryfast -bf 3 -g 20 -crf 12");
+  return file;
+}
+
+// How many frames of each picture type ffprobe finds, as "B 37 I 3 P 24 ".
+std::string picture_types(const fs::path& file) {
+  const std::string command = fmt::format(
+      "ffprobe -v error -select_streams v -show_entries frame=pict_type -of csv=p=0 '{}' | cut -c1 | sort | uniq -c | "
+      "awk '{{printf \"%s %s \", $2, $1}}'",
+      file.string());
+  FILE* pipe = popen(command.c_str(), "r");
+  std::string out;
+  char buffer[256];
+  while (pipe && fgets(buffer, sizeof buffer, pipe)) out += buffer;
+  if (pipe) pclose(pipe);
+  return out;
+}
+
+TEST(PanoramaVideo, EveryFrameKnowsItsIndexThroughBFramesAndTheEditList) {
+  // The file does have B-frames (decoded out of order) and an edit list (x264's delay of 2 frames).
+  const std::string types = picture_types(h264_with_b_frames());
+  ASSERT_NE(types.find("B "), std::string::npos) << types;
+  EXPECT_GT(std::stoi(types.substr(types.find("B ") + 2)), 10) << types;
+  PanoramaVideo video(h264_with_b_frames());
+  EXPECT_EQ(video.width(), kWidth);
+  EXPECT_EQ(video.rate_num(), 30);
+  EXPECT_EQ(video.rate_den(), 1);
+  PanoramaVideoFrame frame;
+  int count = 0;
+  while (video.next(frame)) {
+    EXPECT_EQ(frame.index, count);
+    EXPECT_EQ(read_barcode(frame), frame.index);
+    EXPECT_EQ(frame.time_ns, (frame.index * 1'000'000'000 + 15) / 30);  // the index's time, to the ns
+    ++count;
+  }
+  EXPECT_EQ(count, 64);
+  EXPECT_EQ(video.decode_errors(), 0u);
+}
+
+TEST(PanoramaVideo, WebmVp9Too) {
+  PanoramaVideo video(make_video(test::scratch_dir("panorama-webm"), "vp9.webm", 40, "-c:v libvpx-vp9 -crf 20 -b:v 0 -g 12"));
+  PanoramaVideoFrame frame;
+  int count = 0;
+  while (video.next(frame)) {
+    EXPECT_EQ(frame.index, count);
+    EXPECT_EQ(read_barcode(frame), frame.index);
+    ++count;
+  }
+  EXPECT_EQ(count, 40);
+}
+
+TEST(PanoramaVideo, AHundredRandomSeeksLandOnTheirFrame) {
+  PanoramaVideo video(h264_with_b_frames());
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<int> index(0, 63);
+  PanoramaVideoFrame frame;
+  for (int k = 0; k < 100; ++k) {
+    const int target = index(rng);
+    video.seek(target);
+    ASSERT_TRUE(video.next(frame)) << "seek to " << target;
+    EXPECT_EQ(frame.index, target);
+    EXPECT_EQ(read_barcode(frame), target);
+    if (target < 63) {  // and decoding goes on from there
+      ASSERT_TRUE(video.next(frame));
+      EXPECT_EQ(read_barcode(frame), target + 1);
+    }
+  }
+}
+
+TEST(PanoramaVideo, TenMinutesOfLoopsNeverDrift) {
+  // 64 frames at 30 frames/s looped for 10 minutes: 18000 frames, each index the barcode's.
+  PanoramaVideo video(h264_with_b_frames());
+  PanoramaVideoFrame frame;
+  for (int shown = 0; shown < 18000;) {
+    if (!video.next(frame)) {
+      video.seek(0);
+      continue;
+    }
+    ASSERT_EQ(frame.index, shown % 64) << "frame " << shown;
+    ASSERT_EQ(read_barcode(frame), frame.index) << "frame " << shown;
+    ++shown;
+  }
+}
+
+TEST(PanoramaVideo, TheSourceShowsEachOutputFrameTheVideoFrameOfItsTime) {
+  // A view whose centre pixel looks at bit 0's block (column 8, the equator): at 60 frames/s out of
+  // a 30 frames/s video each video frame shows twice, and the loop starts again after frame 63.
+  SourceConfig config;
+  config.type = SourceType::Panorama;
+  config.pacing = ReplayPacing::Fast;
+  config.panorama.file = h264_with_b_frames();
+  config.panorama.view.width = 64;
+  config.panorama.view.height = 32;
+  config.panorama.view.fps = 60;
+  config.panorama.view.frames = 300;
+  config.panorama.view.yaw_rad = (8.5 / kWidth - 0.5) * 2 * M_PI;
+  PanoramaSource source(config);
+  Frame frame;
+  for (int k = 0; k < 300; ++k) {
+    ASSERT_EQ(source.next(frame), SourceStatus::Frame);
+    ASSERT_TRUE(frame.meta.source_frame_index);
+    EXPECT_EQ(*frame.meta.source_frame_index, (k / 2) % 64) << "output frame " << k;
+    const uint8_t centre = frame.data[16 * frame.bytes_per_line + 3 * 32];
+    EXPECT_EQ(centre > 128, bool(*frame.meta.source_frame_index & 1)) << "output frame " << k << ": " << int(centre);
+  }
+  EXPECT_EQ(source.next(frame), SourceStatus::EndOfStream);
+}
+
+TEST(PanoramaVideo, BadFilesAreRefusedNamingThem) {
+  const fs::path dir = test::scratch_dir("panorama-video-bad");
+  const auto refused = [](const fs::path& file, const std::string& expected) {
+    try {
+      PanoramaVideo video(file);
+      ADD_FAILURE() << file << " was accepted";
+    } catch (const AssetError& e) {
+      EXPECT_NE(std::string(e.what()).find(file.string()), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  };
+  refused(dir / "missing.mp4", "no such file");
+  std::ofstream(dir / "text.mp4") << "not a video\n";
+  refused(dir / "text.mp4", "cannot open");
+  // Cut in half: the index (moov) is at the end of ffmpeg's MP4s, so nothing is readable.
+  std::ifstream in(h264_with_b_frames(), std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::ofstream(dir / "cut.mp4", std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+  refused(dir / "cut.mp4", "cut.mp4");
+  // Not 2:1.
+  const fs::path square = dir / "square.mp4";
+  EXPECT_EQ(std::system(fmt::format("ffmpeg -nostdin -v error -y -f lavfi -i color=c=gray:s=64x64:d=0.2 -c:v libx264 '{}'",
+                                    square.string()).c_str()),
+            0);
+  refused(square, "not a panorama");
+}
+
+}  // namespace
+}  // namespace arpipe
