@@ -4,7 +4,8 @@
 // default) at the horizon, 60 degrees up and at the zenith, prints ms per frame (the median frame), the same against
 // a memcpy of the frame (measured in the same run), and the looked-up positions' error against a
 // double-precision remap (mrcal's unprojection, the rotation, environment_direction_pixel), as an
-// angle in texels: mean and largest over the frames' pixels.
+// angle in texels: mean and largest over the frames' pixels. With --video FILE: the video's decoding
+// to RGB and the pyramid of each frame, ms per frame.
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -20,6 +21,7 @@
 #include "apps/cli/command_line.h"
 #include "bench/benchmarks.h"
 #include "capture/panorama/equirect_image.h"
+#include "capture/panorama/panorama_video.h"
 #include "capture/panorama/panorama_view.h"
 #include "core/environment/environment_layout.h"
 
@@ -89,6 +91,29 @@ Row measure(const EquirectImage& panorama, int width, int height, double pitch_d
   return {width, height, pitch_deg, median(lookup_ms), median(memcpy_ms), error_sum / double(error_count), error_max};
 }
 
+// Decoding a video to RGB frames, and the pyramid the lookup needs of each: ms per frame (medians).
+int run_video_benchmark(const std::string& file) {
+  PanoramaVideo video(file);
+  PanoramaVideoFrame frame;
+  std::vector<double> decode_ms, pyramid_ms;
+  for (;;) {
+    auto start = std::chrono::steady_clock::now();
+    if (!video.next(frame)) break;
+    decode_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+    start = std::chrono::steady_clock::now();
+    const EquirectImage image(std::move(frame.rgb), frame.width, frame.height, file);
+    pyramid_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+  }
+  if (decode_ms.empty()) throw std::runtime_error(file + ": no frame decodes");
+  const double rate = double(video.rate_num()) / double(video.rate_den());
+  const double decode = median(decode_ms), pyramid = median(pyramid_ms);
+  fmt::print("| video | frames | decode to RGB, ms/frame | pyramid, ms/frame | frames/s decoded | frames/s with the pyramid | the video's rate |\n");
+  fmt::print("|---|---:|---:|---:|---:|---:|---:|\n");
+  fmt::print("| {} | {} | {:.1f} | {:.1f} | {:.1f} | {:.1f} | {:.2f} |\n", video.describe(), decode_ms.size(), decode, pyramid,
+             1000 / decode, 1000 / (decode + pyramid), rate);
+  return 0;
+}
+
 int run_panorama_benchmark(int frames, int width, int height) {
   const EquirectImage panorama = test_panorama(width, height);
   fmt::print("panorama {} x {} ({} pyramid levels), {} frames a row, the yaw a golden turn further each frame\n\n", width,
@@ -112,11 +137,14 @@ void add_panorama_benchmark(CLI::App& bench) {
   struct Options {
     int frames = 10;
     std::string size = "4096x2048";
+    std::string video;
   };
   auto options = std::make_shared<Options>();
   command->add_option("--frames", options->frames, "frames a row")->check(CLI::PositiveNumber);
   command->add_option("--size", options->size, "the panorama's size, WxH (2:1, even height)")->type_name("WxH");
+  command->add_option("--video", options->video, "instead: decode this panorama video, ms per frame")->type_name("FILE");
   cli::on_run(command, [options] {
+    if (!options->video.empty()) return run_video_benchmark(options->video);
     int width = 0, height = 0;
     if (std::sscanf(options->size.c_str(), "%dx%d", &width, &height) != 2 || width != 2 * height || height % 2 != 0 ||
         width > EquirectImage::kMaxWidth || height < 2)

@@ -135,7 +135,7 @@ const char* kTriangleGltf = R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"
 
 TEST(SimSceneLoaderExamples, EveryExampleLoadsAndSaysWhatItIsFor) {
   const std::set<std::string> expected{"blur-bench.toml", "calib-board.toml", "default.toml", "probe-indoor.toml", "rolling-shutter.toml",
-                                       "proxies.toml", "sun-outdoor.toml", "tag-pan.toml", "tag-static.toml"};
+                                       "proxies.toml", "proxies-panorama.toml", "sun-outdoor.toml", "tag-pan.toml", "tag-static.toml"};
   std::set<std::string> found;
   for (const auto& entry : fs::directory_iterator(kScenes)) {
     if (entry.path().extension() != ".toml") continue;
@@ -150,6 +150,17 @@ TEST(SimSceneLoaderExamples, EveryExampleLoadsAndSaysWhatItIsFor) {
     std::string first;
     std::getline(in, first);
     EXPECT_EQ(first.rfind("# ", 0), 0u) << first;
+    if (entry.path().filename() == "proxies-panorama.toml") {
+      // A panorama: the whole sphere in the equirectangular layout (fx = W / 2 pi, fy = H / pi, centred).
+      const CameraModel& m = scene.camera.model;
+      EXPECT_EQ(m.lensmodel(), "LENSMODEL_LONLAT");
+      EXPECT_EQ(m.width(), 2 * m.height());
+      EXPECT_NEAR(m.fx(), m.width() / (2 * M_PI), 1e-9);
+      EXPECT_NEAR(m.fy(), m.height() / M_PI, 1e-9);
+      EXPECT_EQ(m.cx(), (m.width() - 1) / 2.0);
+      EXPECT_EQ(m.cy(), (m.height() - 1) / 2.0);
+      continue;
+    }
     // The common camera: 640x480, the mild OPENCV4 lens (calib-board: the wide OPENCV8 one that
     // calibration must recover).
     EXPECT_EQ(scene.camera.model.width(), 640);
