@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <thread>
+#include <vector>
 
 namespace arpipe {
 namespace {
@@ -12,6 +14,7 @@ namespace {
 constexpr float kPi = std::numbers::pi_v<float>;
 // Taps across at most, per level: past that, the next level.
 constexpr int kMaxTapsAcross = 8;
+constexpr int kMaxBands = 16;  // threads a frame at most
 // A pixel may span this many texels down before the next level serves it: bilinear taps then
 // still reach every texel under it.
 constexpr float kMostTexelsDown = 1.5f;
@@ -102,11 +105,22 @@ void PanoramaView::lookup_positions(const EquirectImage& panorama, const Mat3& R
 }
 
 void PanoramaView::render(const EquirectImage& panorama, const Mat3& R_pano_cam, uint8_t* rgb, size_t stride) const {
+  // Bands of rows, one a core: every pixel is looked up on its own, so the result is the same.
+  const int height = camera_->height();
+  const int bands = std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, std::min(kMaxBands, height));
+  std::vector<std::jthread> helpers;
+  for (int b = 1; b < bands; ++b)
+    helpers.emplace_back([&, b] { render_rows(panorama, R_pano_cam, rgb, stride, height * b / bands, height * (b + 1) / bands); });
+  render_rows(panorama, R_pano_cam, rgb, stride, 0, height / bands);
+}
+
+void PanoramaView::render_rows(const EquirectImage& panorama, const Mat3& R_pano_cam, uint8_t* rgb, size_t stride,
+                               int first_row, int end_row) const {
   const auto R = to_float(R_pano_cam);
-  const int width = camera_->width(), height = camera_->height();
+  const int width = camera_->width();
   const float texel_angle = kPi / float(panorama.height());  // a level-0 texel's height (and width at the equator)
   const int last_level = panorama.levels() - 1;
-  for (int y = 0; y < height; ++y) {
+  for (int y = first_row; y < end_row; ++y) {
     uint8_t* row = rgb + size_t(y) * stride;
     for (int x = 0; x < width; ++x) {
       const std::array<float, 4>& ray = rays_[size_t(y) * size_t(width) + size_t(x)];

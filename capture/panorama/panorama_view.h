@@ -35,13 +35,16 @@ class PanoramaView {
 
   // Writes the background seen with the camera turned by R_pano_cam into rgb (RGB24, rows of
   // `stride` bytes): per pixel, the ray's panorama pixel, sampled at the pyramid level and with the
-  // taps across that the pixel's footprint there needs (wider towards the poles).
+  // taps across that the pixel's footprint there needs (wider towards the poles). Bands of rows run
+  // on one thread a core.
   void render(const EquirectImage& panorama, const Mat3& R_pano_cam, uint8_t* rgb, size_t stride) const;
 
   // The level-0 panorama position each pixel's ray meets (row-major), as render computes it.
   void lookup_positions(const EquirectImage& panorama, const Mat3& R_pano_cam, std::vector<std::array<float, 2>>& out) const;
 
  private:
+  void render_rows(const EquirectImage& panorama, const Mat3& R_pano_cam, uint8_t* rgb, size_t stride, int first_row,
+                   int end_row) const;
   std::shared_ptr<const CameraModel> camera_;
   // Per pixel: the unit ray (camera frame) and the angle to its neighbours (radians).
   std::vector<std::array<float, 4>> rays_;
