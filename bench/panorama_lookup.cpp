@@ -20,6 +20,7 @@
 
 #include "apps/cli/command_line.h"
 #include "bench/benchmarks.h"
+#include "bench/proxy_comparison.h"
 #include "capture/panorama/equirect_image.h"
 #include "capture/panorama/panorama_video.h"
 #include "capture/panorama/panorama_view.h"
@@ -29,11 +30,6 @@ namespace arpipe {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-
-double median(std::vector<double> values) {
-  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
-  return values[values.size() / 2];
-}
 
 // A panorama with detail at every scale: smooth colour plus texel noise.
 EquirectImage test_panorama(int width, int height) {
@@ -88,7 +84,7 @@ Row measure(const EquirectImage& panorama, int width, int height, double pitch_d
       ++error_count;
     }
   }
-  return {width, height, pitch_deg, median(lookup_ms), median(memcpy_ms), error_sum / double(error_count), error_max};
+  return {width, height, pitch_deg, bench::median_of(lookup_ms), bench::median_of(memcpy_ms), error_sum / double(error_count), error_max};
 }
 
 // Decoding a video to RGB frames, and the pyramid the lookup needs of each: ms per frame (means).
@@ -152,10 +148,10 @@ void add_panorama_benchmark(CLI::App& bench) {
   cli::on_run(command, [options] {
     if (!options->video.empty()) return run_video_benchmark(options->video);
     int width = 0, height = 0;
-    if (std::sscanf(options->size.c_str(), "%dx%d", &width, &height) != 2 || width != 2 * height || height % 2 != 0 ||
-        width > EquirectImage::kMaxWidth || height < 2)
-      throw std::invalid_argument(fmt::format("--size {}: expected WxH with W = 2 H, H even, W at most {}", options->size,
-                                              EquirectImage::kMaxWidth));
+    if (std::sscanf(options->size.c_str(), "%dx%d", &width, &height) != 2)
+      throw std::invalid_argument(fmt::format("--size {}: expected WxH", options->size));
+    if (const std::string why = EquirectImage::shape_problem(width, height); !why.empty())
+      throw std::invalid_argument(fmt::format("--size {}: {}", options->size, why));
     return run_panorama_benchmark(options->frames, width, height);
   }, cli::Failure{});
 }

@@ -5,12 +5,10 @@
 #include <fmt/format.h>
 
 #include <atomic>
-#include <chrono>
-#include <condition_variable>
 #include <limits>
-#include <mutex>
 #include <optional>
 
+#include "capture/pacing_clock.h"
 #include "capture/recording/recording_reader.h"
 #include "core/log.h"
 
@@ -50,12 +48,7 @@ struct ReplaySource::Impl {
   size_t next_index = 0;
   uint64_t passes = 0;
   std::atomic<uint64_t> skipped{0};
-  // Pacing: the wall-clock time at which the recording's first frame was (virtually) delivered.
-  bool clock_started = false;
-  std::chrono::steady_clock::time_point wall_start;
-  std::mutex mutex;
-  std::condition_variable wake;
-  bool interrupted = false;
+  PacingClock clock;
 
   explicit Impl(const SourceConfig& c) : config(c), reader(open_recording(c.path)) {}
   SourceStatus next(Frame& frame);
@@ -123,13 +116,7 @@ std::shared_ptr<const CameraModel> ReplaySource::camera_model() const { return i
 
 uint64_t ReplaySource::frames_skipped() const { return impl_->skipped; }
 
-void ReplaySource::interrupt() {
-  {
-    std::lock_guard lock(impl_->mutex);
-    impl_->interrupted = true;
-  }
-  impl_->wake.notify_all();
-}
+void ReplaySource::interrupt() { impl_->clock.interrupt(); }
 
 SourceStatus ReplaySource::Impl::next(Frame& frame) {
   Impl& s = *this;
@@ -159,19 +146,7 @@ SourceStatus ReplaySource::Impl::next(Frame& frame) {
     return SourceStatus::EndOfStream;
   }
 
-  if (s.paced) {
-    std::unique_lock lock(s.mutex);
-    if (!s.clock_started) {
-      s.clock_started = true;
-      s.wall_start = std::chrono::steady_clock::now() - std::chrono::nanoseconds(*due_ns);
-    }
-    const auto due = s.wall_start + std::chrono::nanoseconds(*due_ns);
-    s.wake.wait_until(lock, due, [&] { return s.interrupted; });
-    if (s.interrupted) {
-      s.interrupted = false;
-      return SourceStatus::Retry;
-    }
-  }
+  if (s.paced && !s.clock.wait(*due_ns)) return SourceStatus::Retry;
 
   s.next_index = index + 1;
   try {

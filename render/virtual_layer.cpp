@@ -110,12 +110,9 @@ void VirtualLayer::ensure_objects_image(int width, int height) {
 void VirtualLayer::begin_objects(const WorkArea& area, const PixelRect& rect, const PixelRect& objects_rect) {
   if (samples_ <= 1) throw RenderError("the objects' own image needs multisampling");
   const GLfloat transparent[4] = {0, 0, 0, 0};
-  glEnable(GL_SCISSOR_TEST);
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   clear_written_outside(resolved_framebuffer_.get(), resolved_written_, rect);
-  glBindFramebuffer(GL_FRAMEBUFFER, resolved_framebuffer_.get());
-  glViewport(0, 0, width_, height_);
-  glScissor(rect.x, rect.y, rect.width, rect.height);
+  begin_resolved(rect);
   glClearBufferfv(GL_COLOR, 0, transparent);  // one sample a pixel: cheap, unlike the multisampled clear
   ensure_objects_image(area.width, area.height);
   objects_area_ = area;

@@ -8,20 +8,14 @@
 #include <stdexcept>
 
 #include "capture/image_file.h"
+#include "capture/panorama/panorama_file_kind.h"
 #include "core/image/hdr_file.h"
 #include "core/image/srgb.h"
 #include "core/scene/asset_error.h"
 
 namespace arpipe {
-namespace {
 
-bool has_extension(const std::filesystem::path& file, std::initializer_list<const char*> extensions) {
-  std::string ext = file.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return std::find(extensions.begin(), extensions.end(), ext) != extensions.end();
-}
-
-std::string shape_problem(int width, int height) {
+std::string EquirectImage::shape_problem(int width, int height) {
   if (width <= 0 || height <= 0) return fmt::format("an empty image ({} x {})", width, height);
   if (width != 2 * height) return fmt::format("{} x {} is not 2:1, as an equirectangular panorama is", width, height);
   if (height % 2 != 0) return fmt::format("{} x {}: the height must be even", width, height);
@@ -29,8 +23,6 @@ std::string shape_problem(int width, int height) {
     return fmt::format("{} x {} is wider than the limit of {} pixels", width, height, EquirectImage::kMaxWidth);
   return {};
 }
-
-}  // namespace
 
 EquirectImage::EquirectImage(std::vector<uint8_t> rgb, int width, int height, std::string name) : name_(std::move(name)) {
   if (const std::string why = shape_problem(width, height); !why.empty())
@@ -59,7 +51,7 @@ EquirectImage::EquirectImage(std::vector<uint8_t> rgb, int width, int height, st
 
 EquirectImage EquirectImage::load(const std::filesystem::path& file, double hdr_scale) {
   const std::string what = "panorama";
-  if (has_extension(file, {".hdr", ".exr"})) {
+  if (panorama_file_kind(file) == PanoramaFileKind::Hdr) {
     const HdrImage hdr = read_hdr_image(file);
     if (const std::string why = shape_problem(hdr.width, hdr.height); !why.empty())
       throw AssetError(fmt::format("{} \"{}\": {}", what, file.string(), why));

@@ -18,6 +18,10 @@ class EquirectImage {
   static constexpr int kMaxWidth = 16384;
   static constexpr int kMaxSmallestLevelHeight = 8;  // the pyramid stops above this
 
+  // What keeps width x height from being a panorama here (not 2:1, an odd height, wider than
+  // kMaxWidth), or "" for none.
+  static std::string shape_problem(int width, int height);
+
   // rgb: width x height x 3 bytes, row 0 at the top (the zenith); width = 2 height, both even.
   // Throws std::invalid_argument naming `name` for another shape.
   EquirectImage(std::vector<uint8_t> rgb, int width, int height, std::string name);

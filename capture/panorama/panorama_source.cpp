@@ -3,12 +3,11 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
-#include <condition_variable>
-#include <mutex>
 
+#include "capture/pacing_clock.h"
 #include "capture/panorama/equirect_image.h"
+#include "capture/panorama/panorama_file_kind.h"
 #include "capture/panorama/panorama_video.h"
 #include "capture/panorama/panorama_view.h"
 #include "core/environment/hdr_environment.h"
@@ -43,11 +42,7 @@ struct PanoramaSource::Impl {
   std::unique_ptr<PanoramaView> view;
   int64_t interval_ns = 0;
   uint64_t next_index = 0;
-  std::mutex mutex;
-  std::condition_variable wake;
-  bool interrupted = false;
-  bool clock_started = false;
-  std::chrono::steady_clock::time_point wall_start;
+  PacingClock clock;
 };
 
 namespace {
@@ -89,7 +84,7 @@ void PanoramaSource::Impl::show_video_at(int64_t t_ns) {
 PanoramaSource::PanoramaSource(const SourceConfig& config) : impl_(std::make_unique<Impl>()) {
   impl_->config = config;
   const PanoramaConfig& panorama = config.panorama;
-  if (is_panorama_video_file(panorama.file)) {
+  if (panorama_file_kind(panorama.file) == PanoramaFileKind::Video) {
     Impl& s = *impl_;
     s.video = std::make_unique<PanoramaVideo>(panorama.file);
     s.video_frame_ns = std::max<int64_t>(1, (1'000'000'000 * s.video->rate_den() + s.video->rate_num() / 2) / s.video->rate_num());
@@ -117,13 +112,7 @@ std::shared_ptr<const CameraModel> PanoramaSource::camera_model() const { return
 
 std::optional<int64_t> PanoramaSource::frame_interval_ns() const { return impl_->interval_ns; }
 
-void PanoramaSource::interrupt() {
-  {
-    std::lock_guard lock(impl_->mutex);
-    impl_->interrupted = true;
-  }
-  impl_->wake.notify_all();
-}
+void PanoramaSource::interrupt() { impl_->clock.interrupt(); }
 
 SourceStatus PanoramaSource::next(Frame& frame) {
   Impl& s = *impl_;
@@ -133,18 +122,7 @@ SourceStatus PanoramaSource::next(Frame& frame) {
   int64_t start_ns = 0;
   if (__builtin_mul_overflow(int64_t(index), s.interval_ns, &start_ns)) return SourceStatus::EndOfStream;
   try {
-    if (s.config.pacing == ReplayPacing::Timestamps) {
-      std::unique_lock lock(s.mutex);
-      if (!s.clock_started) {
-        s.clock_started = true;
-        s.wall_start = std::chrono::steady_clock::now();
-      }
-      s.wake.wait_until(lock, s.wall_start + std::chrono::nanoseconds(start_ns), [&] { return s.interrupted; });
-      if (s.interrupted) {
-        s.interrupted = false;
-        return SourceStatus::Retry;
-      }
-    }
+    if (s.config.pacing == ReplayPacing::Timestamps && !s.clock.wait(start_ns)) return SourceStatus::Retry;
     const double t_s = double(index) / panorama.view.fps;
     if (s.video) s.show_video_at(start_ns);
     const CameraModel& camera = *s.view->camera();

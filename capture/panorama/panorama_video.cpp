@@ -30,12 +30,6 @@ std::string av_error(int code) {
 
 }  // namespace
 
-bool is_panorama_video_file(const std::filesystem::path& file) {
-  std::string ext = file.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext == ".mp4" || ext == ".m4v" || ext == ".mov" || ext == ".mkv" || ext == ".webm";
-}
-
 struct PanoramaVideo::Impl {
   std::filesystem::path file;
   AVFormatContext* format = nullptr;
@@ -112,8 +106,8 @@ PanoramaVideo::PanoramaVideo(const std::filesystem::path& file) : impl_(std::mak
   AVStream* stream = s.format->streams[s.stream];
   const AVCodecParameters* parameters = stream->codecpar;
   const int width = parameters->width, height = parameters->height;
-  if (width != 2 * height || height <= 0 || height % 2 != 0 || width > EquirectImage::kMaxWidth)
-    s.fail(fmt::format("{} x {} is not a panorama (2:1, even height, at most {} across)", width, height, EquirectImage::kMaxWidth));
+  if (const std::string why = EquirectImage::shape_problem(width, height); !why.empty())
+    s.fail(fmt::format("not a panorama: {}", why));
   s.codec = avcodec_alloc_context3(decoder);
   if (!s.codec || avcodec_parameters_to_context(s.codec, parameters) < 0) s.fail("cannot set up its decoder");
   s.codec->thread_count = 0;  // FFmpeg's choice: one per core

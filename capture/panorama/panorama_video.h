@@ -53,7 +53,4 @@ class PanoramaVideo {
   std::unique_ptr<Impl> impl_;
 };
 
-// Whether a file name is a video the panorama source reads (.mp4, .m4v, .mov, .mkv, .webm).
-bool is_panorama_video_file(const std::filesystem::path& file);
-
 }  // namespace arpipe

@@ -64,6 +64,8 @@ namespace {
   return std::signbit(y) ? -a : a;
 }
 
+// Pixel position (texel centres at integers) of a panorama-frame direction in an equirectangular
+// image of width x height: the float form of environment_direction_pixel.
 [[gnu::always_inline]] inline std::array<float, 2> pixel_of(const std::array<float, 3>& d, int width, int height) {
   const float longitude = fast_atan2(d[0], -d[2] + 0.0f);  // + 0.0f: the poles (-0) get 0, not pi
   const float from_up = fast_atan2(std::sqrt(d[0] * d[0] + d[2] * d[2]), d[1]);
@@ -71,8 +73,6 @@ namespace {
 }
 
 }  // namespace
-
-std::array<float, 2> equirect_pixel(const std::array<float, 3>& d, int width, int height) { return pixel_of(d, width, height); }
 
 PanoramaView::PanoramaView(std::shared_ptr<const CameraModel> camera) : camera_(std::move(camera)) {
   const int width = camera_->width(), height = camera_->height();

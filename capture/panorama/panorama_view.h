@@ -21,10 +21,6 @@ namespace arpipe {
 // The view camera's axes in the panorama's frame (columns: right, down, forward).
 Mat3 panorama_view_rotation(double yaw_rad, double pitch_rad);
 
-// Pixel position (texel centres at integers) of a panorama-frame direction in an equirectangular
-// image of width x height: the float form of environment_direction_pixel, as the lookup computes it.
-std::array<float, 2> equirect_pixel(const std::array<float, 3>& d_pano, int width, int height);
-
 class PanoramaView {
  public:
   // Unprojects every pixel of the camera once. Throws CameraModelError when a pixel cannot be
