@@ -38,6 +38,7 @@ struct PanoramaVideo::Impl {
   AVPacket* packet = nullptr;
   AVFrame* frame = nullptr;
   int stream = -1;
+  int width = 0, height = 0;  // the stream's, checked at open: a frame of another size is skipped
   AVRational time_base{0, 1};
   AVRational rate{0, 1};
   int64_t start_pts = 0;
@@ -67,7 +68,6 @@ struct PanoramaVideo::Impl {
   // Fills `out` from the decoded `frame`.
   void convert(PanoramaVideoFrame& out, int64_t pts) {
     const int w = frame->width, h = frame->height;
-    if (w != codec->width || h != codec->height) fail(fmt::format("the frame size changed to {} x {} mid-stream", w, h));
     scaler = sws_getCachedContext(scaler, w, h, static_cast<AVPixelFormat>(frame->format), w, h, AV_PIX_FMT_RGB24,
                                   SWS_POINT, nullptr, nullptr, nullptr);
     if (!scaler) fail("no conversion from its pixel format to RGB");
@@ -108,6 +108,8 @@ PanoramaVideo::PanoramaVideo(const std::filesystem::path& file) : impl_(std::mak
   const int width = parameters->width, height = parameters->height;
   if (const std::string why = EquirectImage::shape_problem(width, height); !why.empty())
     s.fail(fmt::format("not a panorama: {}", why));
+  s.width = width;
+  s.height = height;
   s.codec = avcodec_alloc_context3(decoder);
   if (!s.codec || avcodec_parameters_to_context(s.codec, parameters) < 0) s.fail("cannot set up its decoder");
   s.codec->thread_count = 0;  // FFmpeg's choice: one per core
@@ -123,8 +125,8 @@ PanoramaVideo::PanoramaVideo(const std::filesystem::path& file) : impl_(std::mak
 
 PanoramaVideo::~PanoramaVideo() = default;
 
-int PanoramaVideo::width() const { return impl_->codec->width; }
-int PanoramaVideo::height() const { return impl_->codec->height; }
+int PanoramaVideo::width() const { return impl_->width; }
+int PanoramaVideo::height() const { return impl_->height; }
 int64_t PanoramaVideo::rate_num() const { return impl_->rate.num; }
 int64_t PanoramaVideo::rate_den() const { return impl_->rate.den; }
 uint64_t PanoramaVideo::decode_errors() const { return impl_->decode_errors; }
@@ -141,6 +143,11 @@ bool PanoramaVideo::next(PanoramaVideoFrame& out) {
       const int64_t pts = s.frame->best_effort_timestamp;
       if (pts == AV_NOPTS_VALUE) {  // a frame with no time cannot have an index
         ++s.decode_errors;
+        continue;
+      }
+      if (s.frame->width != s.width || s.frame->height != s.height) {  // the stream changed size: not the panorama checked
+        ++s.decode_errors;
+        av_frame_unref(s.frame);
         continue;
       }
       if (s.skip_before >= 0 && s.index_of(pts) < s.skip_before) continue;

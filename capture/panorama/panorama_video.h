@@ -41,7 +41,8 @@ class PanoramaVideo {
   std::string describe() const;  // "h264 4096 x 2048 at 30/1 frames/s"
 
   // The next frame in presentation order; false at the end of the stream. A packet or frame that
-  // fails to decode is skipped and counted (decode_errors), never thrown.
+  // fails to decode, or a frame of another size than the stream's, is skipped and counted
+  // (decode_errors), never thrown.
   bool next(PanoramaVideoFrame& out);
   // Seeks so that next() gives the frame of this index (the first one after it when there is none
   // of it exactly). Throws AssetError when the file cannot seek.

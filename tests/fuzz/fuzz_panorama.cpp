@@ -1,0 +1,45 @@
+// libFuzzer target: the panorama source's readers on every input, as a still (PNG/JPEG through
+// capture/image_file, then the 2:1 check and the pyramid) and as a video (FFmpeg's MP4/MOV and
+// Matroska/WebM demuxers and the decoders capture/panorama/panorama_video allows, a few frames and
+// a seek). Anything bad must be an AssetError; a frame that comes out must be a whole panorama.
+#include <cstddef>
+#include <cstdint>
+
+#include "capture/panorama/equirect_image.h"
+#include "capture/panorama/panorama_video.h"
+#include "core/scene/asset_error.h"
+#include "tests/fuzz/fuzz_check.h"
+#include "tests/fuzz/fuzz_temp_dir.h"
+
+namespace {
+
+void load_still(const uint8_t* data, size_t size) {
+  try {
+    const arpipe::EquirectImage image = arpipe::EquirectImage::load(arpipe::fuzz::write_temp_file("panorama.png", data, size), 1.0);
+    ARPIPE_FUZZ_CHECK(image.width() == 2 * image.height(), "a 2:1 still");
+    uint8_t rgb[3];
+    image.sample(image.levels() - 1, -1.5f, -0.5f, rgb);  // across the seam and over the pole
+  } catch (const arpipe::AssetError&) {
+  }
+}
+
+void read_video(const uint8_t* data, size_t size) {
+  try {
+    arpipe::PanoramaVideo video(arpipe::fuzz::write_temp_file("panorama.mp4", data, size));
+    arpipe::PanoramaVideoFrame frame;
+    for (int k = 0; k < 3 && video.next(frame); ++k)
+      ARPIPE_FUZZ_CHECK(frame.width == 2 * frame.height && frame.rgb.size() == size_t(frame.width) * size_t(frame.height) * 3,
+                        "a whole 2:1 frame");
+    video.seek(1);
+    (void)video.next(frame);
+  } catch (const arpipe::AssetError&) {
+  }
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  load_still(data, size);
+  read_video(data, size);
+  return 0;
+}
