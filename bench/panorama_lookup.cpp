@@ -22,9 +22,11 @@
 #include "bench/benchmarks.h"
 #include "bench/proxy_comparison.h"
 #include "capture/panorama/equirect_image.h"
+#include "capture/panorama/panorama_light.h"
 #include "capture/panorama/panorama_video.h"
 #include "capture/panorama/panorama_view.h"
 #include "core/environment/environment_layout.h"
+#include "core/environment/hdr_environment.h"
 
 namespace arpipe {
 namespace {
@@ -53,7 +55,7 @@ struct Row {
 };
 
 // Frames at one pitch, the yaw a golden turn further each frame.
-Row measure(const EquirectImage& panorama, int width, int height, double pitch_deg, int frames) {
+Row measure(EquirectImage& panorama, int width, int height, double pitch_deg, int frames) {
   const double fx = 0.5 * width;  // 90 degrees across
   const auto camera =
       std::make_shared<const CameraModel>(CameraModel::pinhole(fx, fx, 0.5 * (width - 1), 0.5 * (height - 1), width, height));
@@ -87,18 +89,30 @@ Row measure(const EquirectImage& panorama, int width, int height, double pitch_d
   return {width, height, pitch_deg, bench::median_of(lookup_ms), bench::median_of(memcpy_ms), error_sum / double(error_count), error_max};
 }
 
-// Decoding a video to RGB frames, and the pyramid the lookup needs of each: ms per frame (means).
+// Decoding a video to RGB frames, and the whole pyramid of each (what a view at a pole needs):
+// ms per frame (means). Also how many levels the hybrid example's view (configs/panorama.toml:
+// 1280 x 720, 75 degrees across) builds at its pitch and at the horizon: 1 is none past the frame.
 int run_video_benchmark(const std::string& file) {
   PanoramaVideo video(file);
   PanoramaVideoFrame frame;
-  std::vector<double> decode_ms, pyramid_ms;
+  std::vector<double> decode_ms, pyramid_ms, light_ms;
+  std::unique_ptr<PanoramaLight> light;
+  int width = 0, height = 0;
   for (;;) {
     auto start = std::chrono::steady_clock::now();
     if (!video.next(frame)) break;
     decode_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+    width = frame.width;
+    height = frame.height;
     start = std::chrono::steady_clock::now();
-    const EquirectImage image(std::move(frame.rgb), frame.width, frame.height, file);
+    EquirectImage image(std::move(frame.rgb), frame.width, frame.height, file);
+    image.build_levels(image.levels());
     pyramid_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+    if (!light) light = std::make_unique<PanoramaLight>(width, height, default_world_from_probe(0));
+    start = std::chrono::steady_clock::now();
+    const ShRgb9 sh = light->project(image, 4);  // as the source does for light.source = "panorama"
+    light_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+    if (!std::isfinite(sh[0][0])) throw std::runtime_error(file + ": the light is not finite");
   }
   if (decode_ms.empty()) throw std::runtime_error(file + ": no frame decodes");
   const double rate = double(video.rate_num()) / double(video.rate_den());
@@ -108,16 +122,21 @@ int run_video_benchmark(const std::string& file) {
     for (double x : v) sum += x;
     return sum / double(v.size());
   };
-  const double decode = mean(decode_ms), pyramid = mean(pyramid_ms);
-  fmt::print("| video | frames | decode to RGB, ms/frame (mean) | pyramid, ms/frame (mean) | frames/s decoded | frames/s with the pyramid | the video's rate |\n");
-  fmt::print("|---|---:|---:|---:|---:|---:|---:|\n");
-  fmt::print("| {} | {} | {:.1f} | {:.1f} | {:.1f} | {:.1f} | {:.2f} |\n", video.describe(), decode_ms.size(), decode, pyramid,
-             1000 / decode, 1000 / (decode + pyramid), rate);
+  const double fx = 640 / std::tan(37.5 * kPi / 180);
+  const PanoramaView view(std::make_shared<const CameraModel>(CameraModel::pinhole(fx, fx, 639.5, 359.5, 1280, 720)));
+  const EquirectImage shape(std::vector<uint8_t>(size_t(width) * size_t(height) * 3), width, height, file);
+  const auto levels_at = [&](double pitch_deg) { return view.levels_needed(shape, panorama_view_rotation(0, pitch_deg * kPi / 180)); };
+  const double decode = mean(decode_ms), pyramid = mean(pyramid_ms), light_cost = mean(light_ms);
+  fmt::print("| video | frames | decode to RGB, ms/frame (mean) | whole pyramid, ms/frame (mean) | frames/s decoded | frames/s with the whole pyramid "
+             "| levels a 720p 75° view builds at pitch 0, -32, 80 | the panorama's light (SH), ms/frame | the video's rate |\n");
+  fmt::print("|---|---:|---:|---:|---:|---:|---|---:|---:|\n");
+  fmt::print("| {} | {} | {:.1f} | {:.1f} | {:.1f} | {:.1f} | {}, {}, {} of {} | {:.2f} | {:.2f} |\n", video.describe(), decode_ms.size(), decode,
+             pyramid, 1000 / decode, 1000 / (decode + pyramid), levels_at(0), levels_at(-32), levels_at(80), shape.levels(), light_cost, rate);
   return 0;
 }
 
 int run_panorama_benchmark(int frames, int width, int height) {
-  const EquirectImage panorama = test_panorama(width, height);
+  EquirectImage panorama = test_panorama(width, height);
   fmt::print("panorama {} x {} ({} pyramid levels), {} frames a row, the yaw a golden turn further each frame\n\n", width,
              height, panorama.levels(), frames);
   fmt::print("| view | pitch | lookup ms/frame (median) | memcpy of the frame, ms | lookup / memcpy | mean error, texels | max error, texels |\n");

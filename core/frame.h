@@ -9,6 +9,7 @@
 
 #include "core/geometry/se3.h"
 #include "core/pixel_format.h"
+#include "core/sh/sh_basis.h"
 
 namespace arpipe {
 
@@ -43,6 +44,9 @@ struct FrameMetadata {
   // The index of the source's own frame this one shows, when that differs from the sequence: a
   // panorama video's frame (in presentation order), which repeats on each loop.
   std::optional<int64_t> source_frame_index;
+  // The whole light around the camera, when the source holds it (a panorama, which is its own
+  // environment): radiance SH in the world frame, scene-linear (light.source = "panorama").
+  std::optional<ShRgb9> environment_sh;
 
   // Middle of the exposure of the middle row: where a single pose for the frame belongs.
   int64_t exposure_mid_ns() const { return exposure_start_ns + (exposure_ns + readout_ns) / 2; }

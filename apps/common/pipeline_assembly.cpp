@@ -26,7 +26,8 @@ std::unique_ptr<FrameSource> make_source(const Config& config) {
     case SourceType::Replay: return std::make_unique<ReplaySource>(config.source);
     case SourceType::V4l2:
     case SourceType::Libcamera: return make_live_source(config.source);
-    case SourceType::Panorama: return std::make_unique<PanoramaSource>(config.source);
+    case SourceType::Panorama:
+      return std::make_unique<PanoramaSource>(config.source, config.light.source == LightSource::Panorama);
   }
   throw ConfigError(fmt::format("{}: source.type is not one of {}", config.file.string(),
                                 choice_list(ChoiceNames<SourceType>(kSourceTypeNames))));

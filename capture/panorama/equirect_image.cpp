@@ -30,21 +30,26 @@ EquirectImage::EquirectImage(std::vector<uint8_t> rgb, int width, int height, st
   if (rgb.size() != size_t(width) * size_t(height) * 3)
     throw std::invalid_argument(fmt::format("panorama \"{}\": {} bytes for {} x {} RGB", name_, rgb.size(), width, height));
   levels_.push_back({width, height, std::move(rgb)});
-  // Each level the 2 x 2 mean of the one above, while both sides stay even (so that half a turn is
-  // a whole number of texels) and above the smallest height.
-  while (levels_.back().height % 2 == 0 && levels_.back().height / 2 >= kMaxSmallestLevelHeight) {
+  for (int h = height; h % 2 == 0 && h / 2 >= kMaxSmallestLevelHeight; h /= 2) ++possible_levels_;
+}
+
+void EquirectImage::build_levels(int count) {
+  // Each level the 2 x 2 mean of the one above; both sides stay even, so half a turn is a whole
+  // number of texels at every level.
+  while (built_levels() < std::min(count, possible_levels_)) {
     const Level& above = levels_.back();
     Level next{above.width / 2, above.height / 2, {}};
     next.rgb.resize(size_t(next.width) * size_t(next.height) * 3);
-    for (int y = 0; y < next.height; ++y)
+    for (int y = 0; y < next.height; ++y) {
+      const uint8_t* top = above.rgb.data() + size_t(2 * y) * size_t(above.width) * 3;
+      const uint8_t* bottom = top + size_t(above.width) * 3;
+      uint8_t* out = next.rgb.data() + size_t(y) * size_t(next.width) * 3;
       for (int x = 0; x < next.width; ++x)
         for (int c = 0; c < 3; ++c) {
-          const auto at = [&](int dx, int dy) {
-            return int(above.rgb[(size_t(2 * y + dy) * size_t(above.width) + size_t(2 * x + dx)) * 3 + size_t(c)]);
-          };
-          next.rgb[(size_t(y) * size_t(next.width) + size_t(x)) * 3 + size_t(c)] =
-              static_cast<uint8_t>((at(0, 0) + at(1, 0) + at(0, 1) + at(1, 1) + 2) / 4);
+          const size_t i = size_t(6 * x + c);
+          out[3 * x + c] = static_cast<uint8_t>((int(top[i]) + int(top[i + 3]) + int(bottom[i]) + int(bottom[i + 3]) + 2) / 4);
         }
+    }
     levels_.push_back(std::move(next));
   }
 }

@@ -1,5 +1,6 @@
 // A 360° still in the equirectangular layout (core/environment/environment_layout.h), 8-bit sRGB,
-// with a box-filtered pyramid, sampled along a direction: bilinear, wrapping across the seam
+// with a box-filtered pyramid built on demand (a view that never minifies needs none, and a video
+// frame's pyramid is most of its cost past decoding), sampled along a direction: bilinear, wrapping across the seam
 // (the left and right edges) and crossing the poles (the row above the top row is the top row
 // half a turn round), so no direction has a seam or a pinch.
 #pragma once
@@ -30,9 +31,16 @@ class EquirectImage {
   // clipped to [0, 1] and sRGB-encoded). Throws AssetError naming the file and what is wrong.
   static EquirectImage load(const std::filesystem::path& file, double hdr_scale);
 
-  int levels() const { return static_cast<int>(levels_.size()); }
-  int width(int level = 0) const { return levels_[static_cast<size_t>(level)].width; }
-  int height(int level = 0) const { return levels_[static_cast<size_t>(level)].height; }
+  // The levels the pyramid can have (each the 2 x 2 mean of the one above, while both sides stay
+  // even and the height at least kMaxSmallestLevelHeight), and those built so far (level 0 at
+  // least). sample() and texel() read built levels only.
+  int levels() const { return possible_levels_; }
+  int built_levels() const { return static_cast<int>(levels_.size()); }
+  // Builds the levels below `count` not built yet (count is clamped to levels()).
+  void build_levels(int count);
+
+  int width(int level = 0) const { return levels_[0].width >> level; }
+  int height(int level = 0) const { return levels_[0].height >> level; }
   const std::string& name() const { return name_; }
 
   // The bilinear sample at pixel position (u, v) of `level` (texel centres at integers, so level
@@ -48,6 +56,7 @@ class EquirectImage {
     std::vector<uint8_t> rgb;
   };
   std::vector<Level> levels_;
+  int possible_levels_ = 1;
   std::string name_;
 };
 

@@ -13,8 +13,10 @@ namespace arpipe {
 class PanoramaSource : public FrameSource {
  public:
   // Loads the panorama and the view's lens. Throws AssetError (the panorama file), CameraModelError
-  // (the view's model) or ConfigError.
-  explicit PanoramaSource(const SourceConfig& config);
+  // (the view's model) or ConfigError. carries_light (light.source = "panorama"): every frame also
+  // carries the panorama's light (FrameMetadata::environment_sh, capture/panorama/panorama_light.h),
+  // a still's from every texel at setup, a video's from each frame shown.
+  explicit PanoramaSource(const SourceConfig& config, bool carries_light = false);
   ~PanoramaSource() override;
 
   std::string describe() const override;
@@ -32,10 +34,10 @@ class PanoramaSource : public FrameSource {
   std::unique_ptr<Impl> impl_;
 };
 
-// The view camera's pose at time t_s: its centre at position_m, turned by the view's yaw (plus
-// yaw_rad_per_s * t_s) and pitch, in the panorama placed by its yaw about world z.
-SE3 panorama_view_pose(const PanoramaConfig& config, double t_s);
-// The same turn as the rotation from the view camera's frame into the panorama's.
+// The view camera's pose turned by R_pano_cam (the view's axes in the panorama's frame): its centre at
+// position_m, in the panorama placed by its yaw about world z.
+SE3 panorama_view_pose(const PanoramaConfig& config, const Mat3& R_pano_cam);
+// The sweep's turn at time t_s (the view's yaw plus yaw_rad_per_s * t_s, and its pitch), without a track.
 Mat3 panorama_view_rotation_at(const PanoramaConfig& config, double t_s);
 
 }  // namespace arpipe

@@ -35,10 +35,14 @@ double angle_between(const Vec3& a, const Vec3& b) { return std::atan2(norm(cros
 
 }  // namespace
 
-Mat3 panorama_view_rotation(double yaw_rad, double pitch_rad) {
+Mat3 panorama_view_rotation(double yaw_rad, double pitch_rad, double roll_rad) {
   const double cy = std::cos(yaw_rad), sy = std::sin(yaw_rad), cp = std::cos(pitch_rad), sp = std::sin(pitch_rad);
   const Vec3 forward{cp * sy, sp, -cp * cy};
-  const Vec3 right{cy, 0, sy};
+  const Vec3 level_right{cy, 0, sy};
+  const Vec3 level_up = cross(level_right, forward);
+  // The roll turns right towards down (the camera's y) about forward.
+  const double cr = std::cos(roll_rad), sr = std::sin(roll_rad);
+  const Vec3 right = cr * level_right - sr * level_up;
   const Vec3 up = cross(right, forward);
   return {{{right[0], -up[0], forward[0]}, {right[1], -up[1], forward[1]}, {right[2], -up[2], forward[2]}}};
 }
@@ -94,7 +98,24 @@ PanoramaView::PanoramaView(std::shared_ptr<const CameraModel> camera) : camera_(
       const double across = angle_between(r, ray(x + 1 < width ? x + 1 : x - 1, y));
       const double down = angle_between(r, ray(x, y + 1 < height ? y + 1 : y - 1));
       rays_[size_t(y) * size_t(width) + size_t(x)] = {float(r[0]), float(r[1]), float(r[2]), float(std::max(across, down))};
+      widest_footprint_rad_ = std::max(widest_footprint_rad_, std::max(across, down));
+      widest_ray_rad_ = std::max(widest_ray_rad_, std::acos(std::clamp(r[2], -1.0, 1.0)));
     }
+}
+
+int PanoramaView::levels_needed(const EquirectImage& panorama, const Mat3& R_pano_cam) const {
+  // As render_rows chooses a level, with the largest footprint and the smallest cos(latitude) any
+  // pixel can have: every ray is within widest_ray_rad_ of the optical axis, so no ray comes nearer
+  // a pole (+-y) than the axis's angle from it less that. 1 % over: render_rows works in floats.
+  const double texel_angle = std::numbers::pi / panorama.height();
+  const double tall = 1.01 * widest_footprint_rad_ / texel_angle;
+  const double axis_from_pole = std::acos(std::min(1.0, std::abs(R_pano_cam[1][2])));
+  const double nearest_to_pole = std::max(0.0, axis_from_pole - widest_ray_rad_);
+  const double wide = tall / std::max(std::sin(nearest_to_pole), 1e-6);
+  int level = 0;
+  while (level + 1 < panorama.levels() && (tall > kMostTexelsDown * double(1 << level) || wide > double(kMaxTapsAcross << level)))
+    ++level;
+  return level + 1;
 }
 
 void PanoramaView::lookup_positions(const EquirectImage& panorama, const Mat3& R_pano_cam,
@@ -104,7 +125,8 @@ void PanoramaView::lookup_positions(const EquirectImage& panorama, const Mat3& R
   for (size_t i = 0; i < rays_.size(); ++i) out[i] = pixel_of(rotate(R, rays_[i]), panorama.width(), panorama.height());
 }
 
-void PanoramaView::render(const EquirectImage& panorama, const Mat3& R_pano_cam, uint8_t* rgb, size_t stride) const {
+void PanoramaView::render(EquirectImage& panorama, const Mat3& R_pano_cam, uint8_t* rgb, size_t stride) const {
+  panorama.build_levels(levels_needed(panorama, R_pano_cam));
   // Bands of rows, one a core: every pixel is looked up on its own, so the result is the same.
   const int height = camera_->height();
   const int bands = std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, std::min(kMaxBands, height));
@@ -119,7 +141,7 @@ void PanoramaView::render_rows(const EquirectImage& panorama, const Mat3& R_pano
   const auto R = to_float(R_pano_cam);
   const int width = camera_->width();
   const float texel_angle = kPi / float(panorama.height());  // a level-0 texel's height (and width at the equator)
-  const int last_level = panorama.levels() - 1;
+  const int last_level = panorama.built_levels() - 1;  // levels_needed: no pixel asks for more
   for (int y = first_row; y < end_row; ++y) {
     uint8_t* row = rgb + size_t(y) * stride;
     for (int x = 0; x < width; ++x) {

@@ -18,8 +18,9 @@
 
 namespace arpipe {
 
-// The view camera's axes in the panorama's frame (columns: right, down, forward).
-Mat3 panorama_view_rotation(double yaw_rad, double pitch_rad);
+// The view camera's axes in the panorama's frame (columns: right, down, forward). Roll > 0 then tilts
+// the camera about its forward axis to the right (its right side down: the picture turns anticlockwise).
+Mat3 panorama_view_rotation(double yaw_rad, double pitch_rad, double roll_rad = 0);
 
 class PanoramaView {
  public:
@@ -31,9 +32,14 @@ class PanoramaView {
 
   // Writes the background seen with the camera turned by R_pano_cam into rgb (RGB24, rows of
   // `stride` bytes): per pixel, the ray's panorama pixel, sampled at the pyramid level and with the
-  // taps across that the pixel's footprint there needs (wider towards the poles). Bands of rows run
-  // on one thread a core.
-  void render(const EquirectImage& panorama, const Mat3& R_pano_cam, uint8_t* rgb, size_t stride) const;
+  // taps across that the pixel's footprint there needs (wider towards the poles). First builds the
+  // pyramid levels the view can ask for at this turn (levels_needed); bands of rows then run on one
+  // thread a core.
+  void render(EquirectImage& panorama, const Mat3& R_pano_cam, uint8_t* rgb, size_t stride) const;
+
+  // The pyramid levels (from level 0) that some pixel may ask for with the camera turned by
+  // R_pano_cam: a bound from the largest footprint and the view's nearest approach to a pole.
+  int levels_needed(const EquirectImage& panorama, const Mat3& R_pano_cam) const;
 
   // The level-0 panorama position each pixel's ray meets (row-major), as render computes it.
   void lookup_positions(const EquirectImage& panorama, const Mat3& R_pano_cam, std::vector<std::array<float, 2>>& out) const;
@@ -44,6 +50,8 @@ class PanoramaView {
   std::shared_ptr<const CameraModel> camera_;
   // Per pixel: the unit ray (camera frame) and the angle to its neighbours (radians).
   std::vector<std::array<float, 4>> rays_;
+  double widest_footprint_rad_ = 0;  // the largest such angle
+  double widest_ray_rad_ = 0;        // the largest angle of a ray from the camera's +z
 };
 
 }  // namespace arpipe

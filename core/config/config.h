@@ -623,6 +623,22 @@ void visit(V& v, EnvironmentConfig& s) {
   v.key("window", s.window, kShWindowNames, "SH windowing against ringing");
 }
 
+// The panorama source's image as the light (seed 003's suggested image-based lighting): its
+// radiance on 3 SH bands, per video frame, plus render.light_* as the one shadow-casting light.
+struct PanoramaLightConfig {
+  bool direct_light_from_render = true;  // false: the panorama's SH alone (no direct light, no shadows)
+  ShWindow window = ShWindow::None;
+
+  bool operator==(const PanoramaLightConfig&) const = default;
+};
+
+template <class V>
+void visit(V& v, PanoramaLightConfig& s) {
+  v.key("direct_light_from_render", s.direct_light_from_render,
+        "render.light_direction and light_color as the shadow-casting light; false: the panorama alone (no shadows)");
+  v.key("window", s.window, kShWindowNames, "SH windowing against ringing");
+}
+
 // The light stage: where the light comes from.
 struct LightConfig {
   LightSource source = LightSource::Fixed;  // core/config/light_source.h
@@ -634,6 +650,7 @@ struct LightConfig {
   ProbeConfig probe;
   SunConfig sun;
   EnvironmentConfig environment;
+  PanoramaLightConfig panorama;
 
   bool operator==(const LightConfig&) const = default;
 };
@@ -643,7 +660,8 @@ struct LightConfig {
 template <class V>
 void visit(V& v, LightConfig& s) {
   v.key("source", s.source, kLightSourceNames,
-        "fixed: render.light_*; probe: a probe sphere in view; sun: place and time; environment: an HDR probe file");
+        "fixed: render.light_*; probe: a probe sphere in view; sun: place and time; environment: an HDR probe file; "
+        "panorama: the panorama source's image");
   v.key("response", s.response, CameraResponseName{}, "the camera's response curve");
   v.key("smoothing_s", s.smoothing_s, NumberRange::closed(0, 60).in("s"), "time constant of the temporal smoothing");
   v.key("ground_albedo", s.ground_albedo, NumberRange::open_closed(0, 1),
@@ -651,6 +669,7 @@ void visit(V& v, LightConfig& s) {
   v.section("probe", s.probe, "a light probe sphere beside the anchor");
   v.section("sun", s.sun, "the sun from place and time (NREL SPA)");
   v.section("environment", s.environment, "an HDR light probe file as the whole light");
+  v.section("panorama", s.panorama, "the panorama source's image as the light");
 }
 
 struct PngSinkConfig {

@@ -43,6 +43,12 @@ void check_cross_keys(const TomlSection& t, SourceConfig& s) {
            fmt::format("at least reconnect_min_ms ({})", s.reconnect_min_ms), fmt::format("{}", s.reconnect_max_ms));
 }
 
+void check_cross_keys(const TomlSection& t, PanoramaViewConfig& s) {
+  if (!s.track.empty() && (s.yaw_rad_per_s != 0 || s.pitch_rad != 0))
+    t.fail_with(s.yaw_rad_per_s != 0 ? "yaw_deg_per_s" : "pitch_deg",
+                "expected 0 with a track: the track gives the orientation over time (yaw_deg still turns it)");
+}
+
 void check_cross_keys(const TomlSection& t, TrackConfig& s) {
   if (!t.has("bundle")) return;  // the default bundle (tag 0) exists in every family
   const int64_t code_count = create_tag_family(s.family)->ncodes;
@@ -86,6 +92,11 @@ void check_cross_keys(const TomlSection& t, ObjectPhysics& s) {
                                        toml_float(s.track[i].time_s), toml_float(s.track[i - 1].time_s)));
   if (!s.track.empty() && s.kind != ObjectMotion::Kinematic)
     t.fail_with("track", fmt::format("a pose track moves only a kinematic body, not a {} one", object_motion_name(s.kind)));
+}
+
+void check_cross_keys(const TomlSection& t, Config& c) {
+  if (c.light.source == LightSource::Panorama && c.source.type != SourceType::Panorama)
+    t.fail_with("light", "light.source = \"panorama\" needs source.type = \"panorama\" (the light is the panorama's image)");
 }
 
 template <class Section>

@@ -10,12 +10,14 @@ enum class LightSource {
   Probe,        // a light probe sphere in view ([light.probe])
   Sun,          // place and time ([light.sun])
   Environment,  // an HDR light probe file ([light.environment])
+  Panorama,     // the panorama source's own image ([light.panorama], source.type = "panorama")
 };
 
 inline constexpr ChoiceName<LightSource> kLightSourceNames[] = {{"fixed", LightSource::Fixed},
                                                                 {"probe", LightSource::Probe},
                                                                 {"sun", LightSource::Sun},
-                                                                {"environment", LightSource::Environment}};
+                                                                {"environment", LightSource::Environment},
+                                                                {"panorama", LightSource::Panorama}};
 
 inline std::string_view light_source_name(LightSource source) { return choice_name(kLightSourceNames, source); }
 

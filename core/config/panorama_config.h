@@ -32,6 +32,9 @@ struct PanoramaViewConfig {
   double yaw_rad = 0;
   double yaw_rad_per_s = 0;
   double pitch_rad = 0;
+  // Or a head-pose track file (capture/panorama/head_pose_track.h): the orientation over time, turned
+  // right by yaw_rad; yaw_rad_per_s and pitch_rad must then stay 0.
+  std::filesystem::path track;
 
   bool operator==(const PanoramaViewConfig&) const = default;
 };
@@ -48,6 +51,7 @@ void visit(V& v, PanoramaViewConfig& s) {
   v.key("yaw_deg_per_s", s.yaw_rad_per_s, Degrees{NumberRange::closed(-1e5, 1e5).in("degrees/s")},
         "the yaw's sweep (the seed's protocol: 12)");
   v.key("pitch_deg", s.pitch_rad, Degrees{NumberRange::closed(-90, 90)}, "up from the horizon (90 = the zenith)");
+  v.key("track", s.track, "a head-pose track file (t_s with yaw_deg, pitch_deg, roll_deg or qw, qx, qy, qz) instead of the sweep");
 }
 
 struct PanoramaConfig {

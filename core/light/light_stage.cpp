@@ -4,10 +4,12 @@
 #include <fmt/format.h>
 #include <time.h>
 
+#include <numbers>
 #include <optional>
 #include <stdexcept>
 
 #include "core/environment/environment_light.h"
+#include "core/sh/sh_window.h"
 #include "core/log.h"
 #include "core/pipeline/monotonic_clock.h"
 
@@ -73,6 +75,21 @@ void LightStage::configure_loaded(const Config& config, const std::shared_ptr<co
               environment_layout_name(light.environment.layout), environment.ambient_sh[0][0], environment.ambient_sh[0][1],
               environment.ambient_sh[0][2]);
   }
+  if (light.source == LightSource::Panorama) {
+    // The panorama's own light arrives with each frame (FrameMetadata::environment_sh); the direct
+    // light, when kept, is the fixed one (render.light_*), in the same display-referred units.
+    panorama_ = PanoramaLighting{};
+    panorama_.window = light.panorama.window;
+    if (light.panorama.direct_light_from_render && norm(config.render.light_color) > 0) {
+      DirectionalLight direct;
+      direct.direction_world = config.render.light_direction;
+      direct.irradiance = std::numbers::pi * config.render.light_color;
+      direct.angular_diameter_rad = config.render.shadows.light_angular_diameter_deg * std::numbers::pi / 180;
+      direct.local = config.render.light_distance_m > 0;
+      direct.position_world = config.render.light_distance_m * config.render.light_direction;
+      panorama_.direct = direct;
+    }
+  }
   source_ = light.source;
   probe_ = std::move(probe);
   sun_ = std::move(sun);
@@ -93,6 +110,26 @@ void LightStage::process(FrameContext& ctx) noexcept {
   if (source_ == LightSource::Environment) {
     ctx.light = environment_;
     ctx.record_timing(std::string(name()), milliseconds_since(start), "environment file (static)");
+    return;
+  }
+  if (source_ == LightSource::Panorama) {
+    const std::optional<ShRgb9>& sh = ctx.camera.meta.environment_sh;
+    if (!sh) {
+      ctx.light = LightEstimate{};
+      ctx.light.note = "the source gave no panorama light with this frame";
+      ctx.record_timing(std::string(name()), milliseconds_since(start), "no panorama light");
+      return;
+    }
+    ctx.light = LightEstimate{};
+    ctx.light.state = LightState::Estimated;
+    ctx.light.source = "panorama";
+    ctx.light.ambient_sh = *sh;
+    for (size_t i = 0; i < 9; ++i)
+      ctx.light.ambient_sh[i] = sh_window_factor(panorama_.window, sh_band(int(i)), 3) * ctx.light.ambient_sh[i];
+    if (panorama_.direct) ctx.light.lights.push_back(*panorama_.direct);
+    ctx.light.scene_linear = true;
+    ctx.light.confidence = 1;
+    ctx.record_timing(std::string(name()), milliseconds_since(start), "the panorama's image");
     return;
   }
   const bool pose_valid = ctx.pose.state == TrackState::Tracking || ctx.pose.state == TrackState::Predicted;

@@ -1,15 +1,18 @@
 // The light stage: where this frame's light comes from (light.source): the config's fixed light,
 // a light probe sphere in view (probe_light_estimator.h), the sun from place and time
-// (sun_light.h), or an HDR light probe file (environment_light.h). Its estimate travels in
+// (sun_light.h), an HDR light probe file (environment_light.h), or the panorama source's image
+// (capture/panorama/panorama_light.h, arriving with each frame). Its estimate travels in
 // FrameContext::light to the renderer.
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "core/config/light_source.h"
 #include "core/light/ground_radiance.h"
 #include "core/probe/probe_light_estimator.h"
+#include "core/sh/sh_window.h"
 #include "core/sun/sun_light.h"
 #include "core/pipeline/stage.h"
 
@@ -34,6 +37,10 @@ class LightStage final : public Stage {
   std::unique_ptr<ProbeLightEstimator> probe_;
   std::unique_ptr<SunLight> sun_;
   LightEstimate environment_;  // Environment: the same every frame
+  struct PanoramaLighting {
+    std::optional<DirectionalLight> direct;  // render.light_*, unless direct_light_from_render is off
+    ShWindow window = ShWindow::None;
+  } panorama_;                   // Panorama: with the SH each frame brings
   Vec3 probe_centre_{0, 0, 0};
   Vec3 ground_albedo_{0.3, 0.3, 0.3};
   CameraResponse response_;

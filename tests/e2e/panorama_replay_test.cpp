@@ -1,7 +1,8 @@
 // End-to-end: the hybrid example as a user runs it. `arpipe simulate --png` makes the panorama of
 // configs/sim/proxies-panorama.toml, and arpiped runs configs/panorama.toml on it: every frame is
 // composited from the pose the sweep gives (none tracked, none blurred), the pose in each results
-// line is the configured sweep's, and the proxies report hiding part of the cube. Bad panorama
+// line is the configured sweep's, and the proxies report hiding part of the cube; with the still as
+// the light, each frame's ambient light is the still's SH. Bad panorama
 // files stop the daemon at setup with the file named.
 #include <gtest/gtest.h>
 
@@ -11,7 +12,10 @@
 #include <nlohmann/json.hpp>
 #include <numbers>
 
+#include "capture/panorama/equirect_image.h"
+#include "capture/panorama/panorama_light.h"
 #include "capture/panorama/panorama_source.h"
+#include "core/environment/hdr_environment.h"
 #include "core/config/config.h"
 #include "tests/e2e/child_process.h"
 
@@ -58,7 +62,7 @@ TEST(PanoramaReplay, TheHybridExampleRunsFromTheSimulatedStill) {
     EXPECT_EQ(frame["skipped"]["track"], "pose given by the source") << line;
     EXPECT_EQ(frame["blur"]["method"], "off") << line;
     // The pose is the sweep's at index / fps.
-    const SE3 expected = panorama_view_pose(config.source.panorama, lines / config.source.panorama.view.fps);
+    const SE3 expected = panorama_view_pose(config.source.panorama, panorama_view_rotation_at(config.source.panorama, lines / config.source.panorama.view.fps));
     const SE3 reported = SE3::from_rt({frame["T_cam_world"]["r"][0], frame["T_cam_world"]["r"][1], frame["T_cam_world"]["r"][2]},
                                       {frame["T_cam_world"]["t"][0], frame["T_cam_world"]["t"][1], frame["T_cam_world"]["t"][2]});
     const SE3 difference = expected.inverse() * reported;
@@ -71,6 +75,30 @@ TEST(PanoramaReplay, TheHybridExampleRunsFromTheSimulatedStill) {
     EXPECT_TRUE(fs::exists(out / "png" / fmt::format("frame_{:06d}.png", lines))) << lines;
   }
   EXPECT_EQ(lines, kFrames);
+
+  // The same still as the light (light.source = "panorama"): each frame's ambient is the still's SH,
+  // the direct light the config's.
+  std::vector<std::string> lit_overrides = overrides;
+  lit_overrides.insert(lit_overrides.end(), {"light.source=\"panorama\"", "source.panorama.view.frames=2",
+                                             "sinks.results.path=\"" + (out / "lit.jsonl").string() + "\""});
+  args = {"--config", kConfig.string()};
+  for (const std::string& o : lit_overrides) args.insert(args.end(), {"--set", o});
+  ASSERT_EQ(test::run_to_exit(test::build_program("arpiped"), args, out / "logs-lit", &stderr_text), 0) << stderr_text;
+  const EquirectImage image = EquirectImage::load(still, 1.0);
+  const ShRgb9 expected_sh = PanoramaLight(image.width(), image.height(), default_world_from_probe(config.source.panorama.yaw_rad)).project(image);
+  std::ifstream lit(out / "lit.jsonl");
+  int lit_lines = 0;
+  for (std::string line; std::getline(lit, line); ++lit_lines) {
+    const nlohmann::json light = nlohmann::json::parse(line)["light"];
+    EXPECT_EQ(light["source"], "panorama") << line;
+    EXPECT_EQ(light["state"], "estimated") << line;
+    for (size_t i = 0; i < 9; ++i)
+      for (size_t k = 0; k < 3; ++k) EXPECT_NEAR(light["ambient_sh"][i][k].get<double>(), expected_sh[i][k], 1e-9) << i << " " << k;
+    ASSERT_EQ(light["lights"].size(), 1u) << line;
+    for (size_t k = 0; k < 3; ++k)
+      EXPECT_NEAR(light["lights"][0]["direction_world"][k].get<double>(), config.render.light_direction[k], 1e-12);
+  }
+  EXPECT_EQ(lit_lines, 2);
   fs::remove_all(out);
 }
 

@@ -15,8 +15,10 @@ namespace {
 
 void load_still(const uint8_t* data, size_t size) {
   try {
-    const arpipe::EquirectImage image = arpipe::EquirectImage::load(arpipe::fuzz::write_temp_file("panorama.png", data, size), 1.0);
+    arpipe::EquirectImage image = arpipe::EquirectImage::load(arpipe::fuzz::write_temp_file("panorama.png", data, size), 1.0);
     ARPIPE_FUZZ_CHECK(image.width() == 2 * image.height(), "a 2:1 still");
+    image.build_levels(image.levels());
+    ARPIPE_FUZZ_CHECK(image.built_levels() == image.levels(), "the whole pyramid built");
     uint8_t rgb[3];
     image.sample(image.levels() - 1, -1.5f, -0.5f, rgb);  // across the seam and over the pole
   } catch (const arpipe::AssetError&) {

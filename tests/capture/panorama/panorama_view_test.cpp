@@ -112,7 +112,7 @@ TEST(PanoramaView, BackgroundIsTheSceneAlongEachRayAcrossTheSeamAndThePoles) {
       const std::array<double, 3> c = field(d);
       for (size_t k = 0; k < 3; ++k) rgb[(size_t(y) * W + size_t(x)) * 3 + k] = uint8_t(std::lround(c[k]));
     }
-  const EquirectImage panorama(std::move(rgb), W, H, "field");
+  EquirectImage panorama(std::move(rgb), W, H, "field");
   const double fx = 0.5 * 640 / std::tan(50 * kDeg);
   const auto camera = std::make_shared<const CameraModel>(CameraModel::pinhole(fx, fx, 319.5, 239.5, 640, 480));
   const PanoramaView view(camera);
@@ -146,7 +146,7 @@ TEST(PanoramaView, FinePatternTowardsThePoleAveragesInsteadOfAliasing) {
   for (int y = 0; y < H; ++y)
     for (int x = 0; x < W; ++x)
       for (int k = 0; k < 3; ++k) rgb[(size_t(y) * W + size_t(x)) * 3 + size_t(k)] = (x / 4) % 2 ? 255 : 0;
-  const EquirectImage panorama(std::move(rgb), W, H, "stripes");
+  EquirectImage panorama(std::move(rgb), W, H, "stripes");
   const double fx = 0.5 * 320 / std::tan(45 * kDeg);
   const auto camera = std::make_shared<const CameraModel>(CameraModel::pinhole(fx, fx, 159.5, 119.5, 320, 240));
   const PanoramaView view(camera);
@@ -168,6 +168,40 @@ TEST(PanoramaView, FinePatternTowardsThePoleAveragesInsteadOfAliasing) {
   std::cout << "polar cap: mean " << sum / count << ", worst " << worst << " levels off the stripes' mean\n";
   EXPECT_LE(sum / count, 16.0);
   EXPECT_LE(worst, 64.0);
+}
+
+TEST(PanoramaView, PyramidBuiltOnDemandGivesTheSamePictureAsTheWholePyramid) {
+  // The lookup builds only the levels levels_needed bounds for the view's turn: every pixel must get
+  // the same bytes as with every level built, at the horizon, towards and at both poles, for views
+  // that magnify and one that minifies 4 times; and a view that never minifies builds none.
+  constexpr int W = 1024, H = 512;
+  std::vector<uint8_t> rgb(size_t(W) * H * 3);
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<int> byte(0, 255);
+  for (uint8_t& b : rgb) b = uint8_t(byte(rng));
+  EquirectImage whole(rgb, W, H, "noise");
+  whole.build_levels(whole.levels());
+  ASSERT_EQ(whole.built_levels(), 7);  // 512 down to 8
+  struct View {
+    int width, height;
+    double hfov_deg;
+  };
+  for (const View v : {View{640, 480, 60}, View{64, 48, 120}, View{160, 120, 170}}) {
+    const double fx = 0.5 * v.width / std::tan(0.5 * v.hfov_deg * kDeg);
+    const PanoramaView view(std::make_shared<const CameraModel>(
+        CameraModel::pinhole(fx, fx, 0.5 * (v.width - 1), 0.5 * (v.height - 1), v.width, v.height)));
+    for (const double pitch : {0.0, 30.0, 60.0, 80.0, 89.0, 90.0, -45.0, -90.0}) {
+      const Mat3 R = panorama_view_rotation(1.3, pitch * kDeg);
+      EquirectImage lazy(rgb, W, H, "noise");
+      std::vector<uint8_t> a(size_t(v.width) * size_t(v.height) * 3), b(a.size());
+      view.render(lazy, R, a.data(), size_t(v.width) * 3);
+      view.render(whole, R, b.data(), size_t(v.width) * 3);
+      EXPECT_EQ(a, b) << v.width << "x" << v.height << ", pitch " << pitch << ": " << lazy.built_levels() << " levels built";
+      if (v.width == 640 && std::abs(pitch) <= 30) {
+        EXPECT_EQ(lazy.built_levels(), 1) << "pitch " << pitch;
+      }
+    }
+  }
 }
 
 }  // namespace

@@ -618,3 +618,30 @@ TEST(Config, LightResponseIsParsedOnceByTheCameraResponseRule) {
 
 }  // namespace
 }  // namespace arpipe
+
+namespace arpipe {
+namespace {
+
+TEST(Config, PanoramaTrackAndLightNeedTheirCounterparts) {
+  // A head-pose track gives the orientation over time: a sweep or pitch beside it is refused.
+  expect_error("[source]\ntype = \"panorama\"\n[source.panorama]\nfile = \"p.png\"\n[source.panorama.view]\n"
+               "track = \"head.csv\"\nyaw_deg_per_s = 12.0\n",
+               {"test.toml", "source.panorama.view.yaw_deg_per_s", "expected 0 with a track"});
+  expect_error("[source]\ntype = \"panorama\"\n[source.panorama]\nfile = \"p.png\"\n[source.panorama.view]\n"
+               "track = \"head.csv\"\npitch_deg = 10.0\n",
+               {"source.panorama.view.pitch_deg", "expected 0 with a track"});
+  const Config tracked = parse_config(
+      "[source]\ntype = \"panorama\"\n[source.panorama]\nfile = \"p.png\"\n[source.panorama.view]\ntrack = \"head.csv\"\n"
+      "yaw_deg = 30.0\n", "test.toml");
+  EXPECT_EQ(tracked.source.panorama.view.track, "head.csv");
+  // The panorama's light needs a panorama source.
+  expect_error("[light]\nsource = \"panorama\"\n", {"light", "needs source.type = \"panorama\""});
+  const Config lit = parse_config(
+      "[source]\ntype = \"panorama\"\n[source.panorama]\nfile = \"p.png\"\n[light]\nsource = \"panorama\"\n"
+      "[light.panorama]\ndirect_light_from_render = false\n", "test.toml");
+  EXPECT_EQ(lit.light.source, LightSource::Panorama);
+  EXPECT_FALSE(lit.light.panorama.direct_light_from_render);
+}
+
+}  // namespace
+}  // namespace arpipe
