@@ -44,6 +44,9 @@ struct FrameMetadata {
   // The index of the source's own frame this one shows, when that differs from the sequence: a
   // panorama video's frame (in presentation order), which repeats on each loop.
   std::optional<int64_t> source_frame_index;
+  // The place the source shows, when it has several (a panorama's viewpoint: 0 is source.panorama's
+  // own); proxies of other viewpoints are not drawn.
+  std::optional<int> viewpoint;
   // The whole light around the camera, when the source holds it (a panorama, which is its own
   // environment): radiance SH in the world frame, scene-linear (light.source = "panorama").
   std::optional<ShRgb9> environment_sh;

@@ -47,15 +47,17 @@ OcclusionMeter::~OcclusionMeter() = default;
 
 std::vector<ObjectReport> OcclusionMeter::measure(const CameraModel& camera, const SE3& T_cam_world,
                                                   const std::vector<UploadedObject>& objects,
-                                                  const std::vector<UploadedObject>& proxies) const {
+                                                  const std::vector<UploadedObject>& proxies,
+                                                  const std::optional<int>& viewpoint) const {
   std::vector<ObjectReport> reports;
   const SE3 T_world_cam = T_cam_world.inverse();
   const Vec3 eye = T_world_cam.translation();
   const double fx = camera.fx(), fy = camera.fy(), cx = camera.cx(), cy = camera.cy();
   std::vector<std::optional<PlacedScene>> occluders;
   for (size_t p = 0; p < proxies.size() && p < proxy_scenes_.size(); ++p)
-    occluders.push_back(proxy_scenes_[p] ? std::optional<PlacedScene>(std::in_place, proxy_scenes_[p].get(), proxies[p])
-                                         : std::nullopt);
+    occluders.push_back(proxy_scenes_[p] && proxy_at_viewpoint(proxies[p], viewpoint)
+                            ? std::optional<PlacedScene>(std::in_place, proxy_scenes_[p].get(), proxies[p])
+                            : std::nullopt);
   for (size_t i = 0; i < objects.size() && i < object_scenes_.size(); ++i) {
     const UploadedObject& object = objects[i];
     ObjectReport report;

@@ -24,10 +24,11 @@ class OcclusionMeter {
   OcclusionMeter(const Config& config, const LoadedMeshes& meshes);
   ~OcclusionMeter();
 
-  // One report per object of `objects` (as placed for this frame), seen from T_cam_world.
+  // One report per object of `objects` (as placed for this frame), seen from T_cam_world, hidden
+  // by the proxies at the frame's viewpoint (proxy_at_viewpoint).
   std::vector<ObjectReport> measure(const CameraModel& camera, const SE3& T_cam_world,
                                     const std::vector<UploadedObject>& objects,
-                                    const std::vector<UploadedObject>& proxies) const;
+                                    const std::vector<UploadedObject>& proxies, const std::optional<int>& viewpoint = {}) const;
 
  private:
   std::vector<std::shared_ptr<const PrtRayScene>> object_scenes_;  // per render.objects entry

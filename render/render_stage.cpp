@@ -249,7 +249,7 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
   }
   if (occlusion_meter_) {
     const auto measure_start = std::chrono::steady_clock::now();
-    ctx.objects = occlusion_meter_->measure(camera, ctx.pose.T_cam_world, objects_, proxies_);
+    ctx.objects = occlusion_meter_->measure(camera, ctx.pose.T_cam_world, objects_, proxies_, ctx.camera.meta.viewpoint);
     ctx.record_timing("occlusion", milliseconds_since(measure_start));
   }
 
@@ -295,6 +295,7 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
   PixelRect proxy_receivers;
   for (const UploadedObject& proxy : proxies_) {
     if (!proxy.writes_depth && !proxy.shadow_catcher) continue;  // neither hides nor catches: not drawn
+    if (!proxy_at_viewpoint(proxy, ctx.camera.meta.viewpoint)) continue;
     PixelRect r;
     if (!rect_of(proxy, r)) continue;
     if (proxy.shadow_catcher) proxy_receivers = proxy_receivers.united(r);
@@ -478,7 +479,7 @@ const ShadowLookup* RenderStage::shadow_for(FrameContext& ctx, Lighting& lightin
                                         static_cast<float>(centre[2]), static_cast<float>(object.sky_radius_m)});
     }
   for (const UploadedObject& proxy : proxies_)
-    if (proxy.casts_shadows) {
+    if (proxy.casts_shadows && proxy_at_viewpoint(proxy, ctx.camera.meta.viewpoint)) {
       add_caster(proxy);
       real_casters.push_back(&proxy);
     }

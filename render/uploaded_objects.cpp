@@ -187,6 +187,7 @@ std::vector<UploadedObject> upload_proxies(const Config& config, const LoadedMes
     object.shadow_catcher = proxy.roles.receive_shadows;
     object.writes_depth = proxy.roles.occlude;
     object.casts_shadows = proxy.roles.cast_shadows;
+    object.viewpoint = proxy.viewpoint;
     object.base_color = std::array<float, 4>{0, 0, 0, 0};
     std::string sizes;
     for (const OccluderLevel& level : loaded.proxies[i].occluder_levels) {

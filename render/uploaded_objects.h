@@ -33,6 +33,7 @@ struct UploadedObject {
   bool writes_depth = true;   // false: a proxy that receives shadows but hides nothing
   bool casts_shadows = true;  // virtual objects; proxies with the cast_shadows role
   std::string name;           // a proxy's, for messages and results
+  int viewpoint = -1;         // a proxy's panorama viewpoint (render.proxies.viewpoint); -1: every frame
   double specular = 0;  // weight of the environment's glossy reflection (config)
   // An object moved by the physics: its pose at an instant (CLOCK_MONOTONIC ns); T_world_object is
   // then the pose at the frame's mid-exposure. Empty: fixed at T_world_object.
@@ -52,6 +53,12 @@ struct UploadedObject {
   std::vector<std::shared_ptr<const GpuMesh>> occluder_levels;
   std::vector<double> occluder_level_errors_m;
 };
+
+// Whether a proxy stands in the frame's place: it belongs to every viewpoint, or to the one the
+// frame shows (FrameMetadata::viewpoint; a frame without one shows every proxy).
+inline bool proxy_at_viewpoint(const UploadedObject& proxy, const std::optional<int>& viewpoint) {
+  return proxy.viewpoint < 0 || !viewpoint || proxy.viewpoint == *viewpoint;
+}
 
 
 // The meshes of render.objects read (and their PRT transfer baked or taken from the cache) on the

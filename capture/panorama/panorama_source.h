@@ -24,7 +24,8 @@ class PanoramaSource : public FrameSource {
   std::shared_ptr<const CameraModel> camera_model() const override;
   std::optional<int64_t> frame_interval_ns() const override;
   // Frame k (RGB24) shows the view at time k / fps: exposure_start_ns = k / fps in ns, exposure 0
-  // (a still has no motion blur), sequence k. Paced at fps with source.pacing = "timestamps".
+  // (a still has no motion blur), sequence k, the viewpoint shown (FrameMetadata::viewpoint; with
+  // several, each for view.dwell_s in turn). Paced at fps with source.pacing = "timestamps".
   // Ends after view.frames frames (never with 0).
   SourceStatus next(Frame& frame) override;
   void interrupt() override;
@@ -34,10 +35,21 @@ class PanoramaSource : public FrameSource {
   std::unique_ptr<Impl> impl_;
 };
 
-// The view camera's pose turned by R_pano_cam (the view's axes in the panorama's frame): its centre at
-// position_m, in the panorama placed by its yaw about world z.
+// The view camera's pose turned by R_pano_cam (the view's axes in the panorama's frame): its centre
+// at the viewpoint's position_m, in its panorama placed by its yaw about world z. The config's own
+// form is viewpoint 0's.
+SE3 panorama_view_pose(const PanoramaViewpoint& viewpoint, const Mat3& R_pano_cam);
 SE3 panorama_view_pose(const PanoramaConfig& config, const Mat3& R_pano_cam);
-// The sweep's turn at time t_s (the view's yaw plus yaw_rad_per_s * t_s, and its pitch), without a track.
+// The sweep's turn t_s after arriving at a viewpoint (the view's yaw plus yaw_rad_per_s * t_s, and
+// its pitch), without a track.
 Mat3 panorama_view_rotation_at(const PanoramaConfig& config, double t_s);
+
+// Where the view is at output time t_ns (>= 0): viewpoint (t / dwell) mod their count, arrived at
+// the last multiple of dwell_s; viewpoint 0 from 0 throughout with one viewpoint.
+struct PanoramaStop {
+  size_t viewpoint = 0;
+  int64_t arrived_ns = 0;
+};
+PanoramaStop panorama_stop_at(const PanoramaConfig& config, int64_t t_ns);
 
 }  // namespace arpipe

@@ -309,6 +309,9 @@ struct SceneProxy {
   std::string collision_mesh;          // a (simplified) glTF file for collisions; "": the mesh
   double restitution = 1.0;            // 1: the body's own restitution applies (combined by product)
   double friction = 1.0;
+  // A panorama source's viewpoint this proxy stands in (source.panorama: 0 its own table, k the
+  // k-th [[source.panorama.viewpoints]]); -1: every frame. Colliders stay in the physics throughout.
+  int viewpoint = -1;
 
   bool operator==(const SceneProxy&) const = default;
 };
@@ -330,6 +333,8 @@ void visit(V& v, SceneProxy& s) {
   v.key("collision_mesh", s.collision_mesh, "a (simplified) glTF file for collisions; \"\": the mesh");
   v.key("restitution", s.restitution, NumberRange::closed(0, 1), "1: the body's own applies");
   v.key("friction", s.friction, NumberRange::closed(0, 10), "1: the body's own applies");
+  v.key("viewpoint", s.viewpoint, IntRange{-1, int(PanoramaConfig::kMaxViewpoints) - 1},
+        "the panorama viewpoint it stands in (0: source.panorama's own); -1: every frame");
 }
 
 // The rigid-body world of render.objects[].physics and the "collide" proxies (core/physics).

@@ -43,6 +43,18 @@ void check_cross_keys(const TomlSection& t, SourceConfig& s) {
            fmt::format("at least reconnect_min_ms ({})", s.reconnect_min_ms), fmt::format("{}", s.reconnect_max_ms));
 }
 
+void check_cross_keys(const TomlSection& t, PanoramaViewpoint& s) {
+  if (s.file.empty()) t.fail_with("file", "expected the viewpoint's panorama file");
+}
+
+void check_cross_keys(const TomlSection& t, PanoramaConfig& s) {
+  if (s.viewpoints.size() + 1 > PanoramaConfig::kMaxViewpoints)
+    t.fail_with("viewpoints", fmt::format("{} viewpoints, more than the limit of {}", s.viewpoints.size() + 1,
+                                          PanoramaConfig::kMaxViewpoints));
+  if (!s.viewpoints.empty() && s.view.dwell_s <= 0)
+    t.fail_with("viewpoints", "expected source.panorama.view.dwell_s > 0 with more than one viewpoint (the time at each)");
+}
+
 void check_cross_keys(const TomlSection& t, PanoramaViewConfig& s) {
   if (!s.track.empty() && (s.yaw_rad_per_s != 0 || s.pitch_rad != 0))
     t.fail_with(s.yaw_rad_per_s != 0 ? "yaw_deg_per_s" : "pitch_deg",
@@ -97,6 +109,18 @@ void check_cross_keys(const TomlSection& t, ObjectPhysics& s) {
 void check_cross_keys(const TomlSection& t, Config& c) {
   if (c.light.source == LightSource::Panorama && c.source.type != SourceType::Panorama)
     t.fail_with("light", "light.source = \"panorama\" needs source.type = \"panorama\" (the light is the panorama's image)");
+  // A proxy's viewpoint must be one the source has.
+  const int viewpoints = c.source.type == SourceType::Panorama ? int(c.source.panorama.viewpoint_count()) : 0;
+  for (size_t i = 0; i < c.render.proxies.size(); ++i) {
+    const int k = c.render.proxies[i].viewpoint;
+    if (k < viewpoints) continue;
+    const std::string expected =
+        viewpoints == 0 ? "-1 (viewpoints belong to a panorama source)" : fmt::format("-1 or a viewpoint in [0, {}]", viewpoints - 1);
+    if (const std::optional<TomlSection> render = t.section("render"))
+      if (const std::vector<TomlSection> proxies = render->sections("proxies"); i < proxies.size())
+        proxies[i].fail("viewpoint", expected, fmt::format("{}", k));
+    t.fail_with("render", fmt::format("render.proxies[{}].viewpoint: expected {}, found {}", i, expected, k));
+  }
 }
 
 template <class Section>

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <numbers>
+#include <vector>
 
 #include "core/config/choice_names.h"
 #include "core/config/config_rules.h"
@@ -35,6 +36,10 @@ struct PanoramaViewConfig {
   // Or a head-pose track file (capture/panorama/head_pose_track.h): the orientation over time, turned
   // right by yaw_rad; yaw_rad_per_s and pitch_rad must then stay 0.
   std::filesystem::path track;
+  // With more than one viewpoint: seconds at each before the view moves to the next (and from the
+  // last back to the first); the sweep starts again at each. The seed's protocol: 60 (720 degrees
+  // at 12 degrees/s).
+  double dwell_s = 0;
 
   bool operator==(const PanoramaViewConfig&) const = default;
 };
@@ -52,6 +57,27 @@ void visit(V& v, PanoramaViewConfig& s) {
         "the yaw's sweep (the seed's protocol: 12)");
   v.key("pitch_deg", s.pitch_rad, Degrees{NumberRange::closed(-90, 90)}, "up from the horizon (90 = the zenith)");
   v.key("track", s.track, "a head-pose track file (t_s with yaw_deg, pitch_deg, roll_deg or qw, qx, qy, qz) instead of the sweep");
+  v.key("dwell_s", s.dwell_s, NumberRange::closed(0, 1e6).in("s"),
+        "with [[source.panorama.viewpoints]]: time at each viewpoint before the next (the seed's protocol: 60)");
+}
+
+// Another place a panorama was taken (seed 003's teleport points), visited after the one before.
+// Its proxies are those whose render.proxies.viewpoints name it (or name none).
+struct PanoramaViewpoint {
+  std::filesystem::path file;
+  Vec3 position_m{0, 0, 0};
+  double yaw_rad = 0;
+  double hdr_scale = 1;
+
+  bool operator==(const PanoramaViewpoint&) const = default;
+};
+
+template <class V>
+void visit(V& v, PanoramaViewpoint& s) {
+  v.key("file", s.file, "a still or a video, as source.panorama.file (same layout)");
+  v.key("position_m", s.position_m, "where in the world it was taken");
+  v.key("yaw_deg", s.yaw_rad, Degrees{NumberRange::closed(-360, 360)}, "its turn about world z");
+  v.key("hdr_scale", s.hdr_scale, NumberRange::open_closed(0, 1e12), "HDR files: radiance to display value (1 = white)");
 }
 
 struct PanoramaConfig {
@@ -63,6 +89,15 @@ struct PanoramaConfig {
   double yaw_rad = 0;                  // its turn about world z (as light.environment.yaw_deg)
   double hdr_scale = 1;                // .hdr / .exr: the file's radiance to display values (1.0 = white)
   PanoramaViewConfig view;
+  // Viewpoints 1, 2, ... (this table's own file, position and yaw are viewpoint 0).
+  std::vector<PanoramaViewpoint> viewpoints;
+  static constexpr size_t kMaxViewpoints = 64;
+
+  // Viewpoint k (0: this table's own), k < viewpoint_count().
+  PanoramaViewpoint viewpoint(size_t k) const {
+    return k == 0 ? PanoramaViewpoint{file, position_m, yaw_rad, hdr_scale} : viewpoints.at(k - 1);
+  }
+  size_t viewpoint_count() const { return 1 + viewpoints.size(); }
 
   bool operator==(const PanoramaConfig&) const = default;
 };
@@ -75,6 +110,7 @@ void visit(V& v, PanoramaConfig& s) {
   v.key("yaw_deg", s.yaw_rad, Degrees{NumberRange::closed(-360, 360)}, "its turn about world z (0: the centre looks along +y)");
   v.key("hdr_scale", s.hdr_scale, NumberRange::open_closed(0, 1e12), "HDR files: radiance to display value (1 = white)");
   v.section("view", s.view, "the camera that looks at the panorama");
+  v.sections("viewpoints", s.viewpoints, "more places, each its own panorama: [[source.panorama.viewpoints]], visited in turn");
 }
 
 }  // namespace arpipe

@@ -171,6 +171,36 @@ TEST(Proxies, HideTheCubeBehindThemAtPixelCentres) {
   EXPECT_GT(seen_without, visible + 300);
 }
 
+// A proxy of one panorama viewpoint (render.proxies.viewpoint) stands only in frames of that
+// viewpoint: elsewhere the cube is drawn and reported as if the carton were not there.
+TEST(Proxies, AProxyStandsOnlyInItsOwnViewpoint) {
+  Config config = proxy_config(1, ProxyRoles{});
+  config.render.proxies[0].viewpoint = 1;
+  harness().configure(config);
+  const SE3 pose = oblique_pose();
+  const auto seen_at = [&](std::optional<int> viewpoint, double& hidden) {
+    FrameContext ctx = make_context(black_frame(), pinhole_camera(), pose);
+    ctx.camera.meta.viewpoint = viewpoint;
+    harness().process(ctx);
+    EXPECT_TRUE(ctx.virtual_layer_drawn);
+    int seen = 0;
+    for (int y = 0; y < kHeight; ++y)
+      for (int x = 0; x < kWidth; ++x) seen += linear_at(ctx.output, x, y) > 0.5;
+    hidden = ctx.objects.empty() ? -1 : ctx.objects[0].hidden;
+    return seen;
+  };
+  double hidden_here = 0, hidden_elsewhere = 0, hidden_unknown = 0;
+  const int here = seen_at(1, hidden_here), elsewhere = seen_at(0, hidden_elsewhere), unknown = seen_at(std::nullopt, hidden_unknown);
+  EXPECT_GT(elsewhere, here + 300);  // as without the proxy (the test above: 300 more pixels and up)
+  EXPECT_EQ(unknown, here);          // a frame without a viewpoint shows every proxy
+  EXPECT_GT(hidden_here, 0.3);
+  EXPECT_EQ(hidden_elsewhere, 0.0);
+  // The same frames without the proxy at all see what viewpoint 0 sees.
+  harness().configure(proxy_config(1, ProxyRoles{false, false, false, false}));
+  double hidden_none = 0;
+  EXPECT_EQ(seen_at(0, hidden_none), elsewhere);
+}
+
 // The frame's report says how much of the cube the carton hid, and by name: against the share of
 // the cube's own 8 x 8 subpixel samples that the carton hides, within the meter's 24 x 24 ray
 // grid's sampling error (about 0.03 for a few hundred rays on the cube).

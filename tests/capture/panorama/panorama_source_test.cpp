@@ -2,6 +2,7 @@
 // refused at setup with the file named.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <numbers>
@@ -10,6 +11,7 @@
 #include "capture/panorama/panorama_source.h"
 #include "capture/panorama/panorama_view.h"
 #include "core/environment/environment_layout.h"
+#include "core/image/srgb.h"
 #include "core/scene/asset_error.h"
 #include "tests/capture/capture_test_support.h"
 
@@ -99,6 +101,46 @@ TEST(PanoramaSource, RefusesBadFilesNamingThem) {
   refused(dir / "cut.png", "cannot be decoded");
   std::ofstream((dir / "text.png").string()) << "not an image at all\n";
   refused(dir / "text.png", "text.png");
+}
+
+TEST(PanoramaSource, TeleportsBetweenViewpointsEachWithItsPanoramaPoseSweepAndLight) {
+  // Three viewpoints, grey 60, 120 and 200, each 0.5 s (2 frames at 4 frames/s), then back to the
+  // first: each frame shows its viewpoint's image from its position and yaw, the sweep starting
+  // again on arrival, and (light.source = "panorama") its own uniform light, L00 = L sqrt(4 pi).
+  const auto dir = test::scratch_dir("panorama-viewpoints");
+  SourceConfig config = panorama_config(dir / "0.png");
+  config.panorama.view.fps = 4;
+  config.panorama.view.frames = 8;
+  config.panorama.view.dwell_s = 0.5;
+  const std::array<int, 3> grey{60, 120, 200};
+  for (int k = 0; k < 3; ++k) {
+    const std::filesystem::path file = dir / (std::to_string(k) + ".png");
+    cv::imwrite(file.string(), cv::Mat(256, 512, CV_8UC3, cv::Scalar(grey[k], grey[k], grey[k])));
+    if (k > 0) config.panorama.viewpoints.push_back({file, Vec3{0.5 * k, 1.0, 0.2}, 30 * k * kDeg, 1.0});
+  }
+  ASSERT_EQ(config.panorama.viewpoint_count(), 3u);
+  PanoramaSource source(config, true);
+  Frame frame;
+  for (int f = 0; f < 8; ++f) {
+    ASSERT_EQ(source.next(frame), SourceStatus::Frame);
+    const int k = (f / 2) % 3;
+    const PanoramaStop stop = panorama_stop_at(config.panorama, int64_t(f) * 250'000'000);
+    EXPECT_EQ(stop.viewpoint, size_t(k)) << f;
+    EXPECT_EQ(stop.arrived_ns, int64_t(f / 2) * 500'000'000) << f;
+    ASSERT_EQ(frame.meta.viewpoint, k) << f;
+    EXPECT_EQ(frame.data[3 * 10], grey[size_t(k)]) << f;
+    const PanoramaViewpoint place = config.panorama.viewpoint(size_t(k));
+    const SE3 T_world_cam = frame.meta.known_T_cam_world->inverse();
+    for (size_t i = 0; i < 3; ++i) EXPECT_NEAR(T_world_cam.translation()[i], place.position_m[i], 1e-12) << f;
+    // The sweep's yaw (10 + 12 t degrees, t since arriving) plus the viewpoint's own yaw (a turn
+    // counter-clockwise seen from above, so the view looks that much further left).
+    const double yaw = (10 + 12 * (f % 2) * 0.25) * kDeg - place.yaw_rad;
+    const Vec3 forward = T_world_cam.rotate({0, 0, 1});
+    EXPECT_NEAR(forward[0], std::sin(yaw), 1e-12) << f;
+    EXPECT_NEAR(forward[1], std::cos(yaw), 1e-12) << f;
+    ASSERT_TRUE(frame.meta.environment_sh) << f;
+    EXPECT_NEAR((*frame.meta.environment_sh)[0][0], srgb_decode(grey[size_t(k)] / 255.0) * std::sqrt(4 * std::numbers::pi), 1e-9) << f;
+  }
 }
 
 }  // namespace

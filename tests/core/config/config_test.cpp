@@ -643,5 +643,22 @@ TEST(Config, PanoramaTrackAndLightNeedTheirCounterparts) {
   EXPECT_FALSE(lit.light.panorama.direct_light_from_render);
 }
 
+TEST(Config, PanoramaViewpointsNeedADwellAndTheirProxiesAViewpointThatExists) {
+  const std::string two = "[source]\ntype = \"panorama\"\n[source.panorama]\nfile = \"a.png\"\n"
+                          "[[source.panorama.viewpoints]]\nfile = \"b.png\"\nposition_m = [1.0, 0.0, 0.0]\n";
+  expect_error(two, {"source.panorama.viewpoints", "dwell_s > 0"});
+  const Config ok = parse_config(two + "[source.panorama.view]\ndwell_s = 60.0\n[[render.proxies]]\nviewpoint = 1\n", "test.toml");
+  ASSERT_EQ(ok.source.panorama.viewpoint_count(), 2u);
+  EXPECT_EQ(ok.source.panorama.viewpoint(1).file, "b.png");
+  EXPECT_EQ(ok.source.panorama.viewpoint(1).position_m, (Vec3{1, 0, 0}));
+  EXPECT_EQ(ok.render.proxies[0].viewpoint, 1);
+  expect_error(two + "[source.panorama.view]\ndwell_s = 60.0\n[[render.proxies]]\nviewpoint = 2\n",
+               {"render.proxies[0].viewpoint", "-1 or a viewpoint in [0, 1]", "found 2"});
+  expect_error("[[render.proxies]]\nviewpoint = 0\n", {"render.proxies[0].viewpoint", "viewpoints belong to a panorama source"});
+  expect_error("[source]\ntype = \"panorama\"\n[source.panorama]\nfile = \"a.png\"\n[[source.panorama.viewpoints]]\n"
+               "position_m = [1.0, 0.0, 0.0]\n[source.panorama.view]\ndwell_s = 1.0\n",
+               {"source.panorama.viewpoints[0].file", "expected the viewpoint's panorama file"});
+}
+
 }  // namespace
 }  // namespace arpipe

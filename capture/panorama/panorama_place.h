@@ -1,0 +1,56 @@
+// One viewpoint of a panorama source (seed 003's teleport point): its still, or its video looped
+// from the moment the view arrives, and the light it gives (light.source = "panorama").
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "capture/panorama/equirect_image.h"
+#include "capture/panorama/panorama_light.h"
+#include "capture/panorama/panorama_video.h"
+#include "core/config/panorama_config.h"
+#include "core/sh/sh_basis.h"
+
+namespace arpipe {
+
+class PanoramaPlace {
+ public:
+  // Loads the still, or opens the video and decodes its first frame (then closes it again until
+  // arrive()). carries_light: the panorama's SH too (a still's from every texel, an HDR still's
+  // unclipped; a video's from each frame shown). Throws AssetError naming the file.
+  PanoramaPlace(const PanoramaViewpoint& viewpoint, bool carries_light);
+  ~PanoramaPlace();
+  PanoramaPlace(PanoramaPlace&&) noexcept;
+
+  // The view arrives: a video opens and starts again from its first frame. leave() closes it, so
+  // only the viewpoint in view holds a decoder.
+  void arrive();
+  void leave();
+
+  // The panorama on screen t_ns after arriving (a video frame is on screen from its presentation
+  // time to the next one's, the last for one frame time, then the video loops). Throws on a video
+  // that cannot be read back from its start.
+  EquirectImage& show_at(int64_t t_ns);
+
+  // The shown video frame's index (presentation order from 0); none for a still.
+  std::optional<int64_t> frame_index() const;
+  const std::optional<ShRgb9>& light_sh() const { return light_sh_; }
+  std::string describe() const;
+
+ private:
+  PanoramaViewpoint viewpoint_;
+  bool is_video_ = false;
+  std::unique_ptr<EquirectImage> panorama_;  // the still, or the video frame shown
+  std::unique_ptr<PanoramaVideo> video_;     // open while the view is here
+  std::string video_description_;
+  PanoramaVideoFrame shown_, upcoming_;
+  bool has_upcoming_ = false;
+  int64_t loop_offset_ns_ = 0;  // the durations of the passes done
+  int64_t video_frame_ns_ = 0;  // one frame at the video's nominal rate
+  std::unique_ptr<PanoramaLight> light_;     // a video's, for each frame shown
+  std::optional<ShRgb9> light_sh_;
+};
+
+}  // namespace arpipe
