@@ -4,6 +4,8 @@ extern "C" {
 #include <libavcodec/avcodec.h>
 #include <libavformat/avformat.h>
 #include <libavutil/imgutils.h>
+#include <libavutil/spherical.h>
+#include <libavutil/stereo3d.h>
 #include <libswscale/swscale.h>
 }
 
@@ -59,6 +61,37 @@ struct PanoramaVideo::Impl {
     throw AssetError(fmt::format("panorama video \"{}\": {}", file.string(), why));
   }
 
+  // The file's own word on what it holds, where it says (Google's Spherical Video V2 boxes in MP4,
+  // sv3d and st3d; Matroska's Projection and StereoMode), before its shape is checked, so that a
+  // cubemap, a cropped or a stereo 360 video is refused for what it is: only the whole mono
+  // equirectangular layout is built.
+  void check_spherical_metadata(const AVStream* stream) const {
+    size_t size = 0;
+    if (const uint8_t* data = av_stream_get_side_data(stream, AV_PKT_DATA_SPHERICAL, &size);
+        data && size >= sizeof(AVSphericalMapping)) {
+      const auto* mapping = reinterpret_cast<const AVSphericalMapping*>(data);
+      const bool cropped = mapping->bound_left || mapping->bound_top || mapping->bound_right || mapping->bound_bottom;
+      if (mapping->projection != AV_SPHERICAL_EQUIRECTANGULAR && !(mapping->projection == AV_SPHERICAL_EQUIRECTANGULAR_TILE && cropped))
+        fail(fmt::format("its spherical metadata says the {} projection; only equirectangular panoramas are supported",
+                         av_spherical_projection_name(mapping->projection)));
+      if (cropped)  // the tiled form: an equirectangular image of part of the sphere
+        fail(fmt::format("its spherical metadata crops the sphere (bounds left {}, top {}, right {}, bottom {} of 2^32); "
+                         "only whole panoramas are supported",
+                         mapping->bound_left, mapping->bound_top, mapping->bound_right, mapping->bound_bottom));
+      if (mapping->yaw || mapping->pitch || mapping->roll)
+        log::warn("panorama video \"{}\": its spherical metadata's pose (yaw {:.2f}, pitch {:.2f}, roll {:.2f} degrees) is "
+                  "not applied: turn it with source.panorama.yaw_deg",
+                  file.string(), mapping->yaw / 65536.0, mapping->pitch / 65536.0, mapping->roll / 65536.0);
+    }
+    if (const uint8_t* data = av_stream_get_side_data(stream, AV_PKT_DATA_STEREO3D, &size);
+        data && size >= sizeof(AVStereo3D)) {
+      const auto* stereo = reinterpret_cast<const AVStereo3D*>(data);
+      if (stereo->type != AV_STEREO3D_2D)
+        fail(fmt::format("its metadata says it is stereo ({}); stereo layouts are not built yet, only mono",
+                         av_stereo3d_type_name(stereo->type)));
+    }
+  }
+
   int64_t index_of(int64_t pts) const {
     // (pts - start) x time_base x rate, rounded to the nearest frame.
     return av_rescale_q_rnd(pts - start_pts, time_base, av_inv_q(rate),
@@ -104,6 +137,7 @@ PanoramaVideo::PanoramaVideo(const std::filesystem::path& file) : impl_(std::mak
   s.stream = av_find_best_stream(s.format, AVMEDIA_TYPE_VIDEO, -1, -1, &decoder, 0);
   if (s.stream < 0 || !decoder) s.fail("no video stream that H.264, HEVC, VP8, VP9 or AV1 decoding reads");
   AVStream* stream = s.format->streams[s.stream];
+  s.check_spherical_metadata(stream);
   const AVCodecParameters* parameters = stream->codecpar;
   const int width = parameters->width, height = parameters->height;
   if (const std::string why = EquirectImage::shape_problem(width, height); !why.empty())

@@ -1,13 +1,22 @@
 // Panorama videos: every frame's index from its presentation time equals the index drawn into it
 // (a barcode), through B-frames and an MP4 edit list (x264), in WebM (VP9), after 100 random seeks
-// and over a 10-minute loop; bad files refused with their name. The videos are made here with
-// Debian's ffmpeg command from raw frames.
+// and over a 10-minute loop; bad files refused with their name, and files whose spherical metadata
+// says cubemap, cropped or stereo refused for that. The videos are made here with Debian's ffmpeg
+// command from raw frames (and remuxed with the metadata through FFmpeg's libraries).
+extern "C" {
+#include <libavcodec/avcodec.h>
+#include <libavformat/avformat.h>
+#include <libavutil/spherical.h>
+#include <libavutil/stereo3d.h>
+}
+
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <optional>
 #include <random>
 
 #include "capture/panorama/panorama_source.h"
@@ -191,6 +200,79 @@ TEST(PanoramaVideo, BadFilesAreRefusedNamingThem) {
                                     square.string()).c_str()),
             0);
   refused(square, "not a panorama");
+}
+
+// Copies the MP4 `in` to `out` with spherical metadata on its video stream, written as Google's
+// Spherical Video V2 boxes (sv3d, st3d: FFmpeg's MP4 muxer writes them at "unofficial" strictness).
+void remux_with_metadata(const fs::path& in, const fs::path& out, std::optional<AVSphericalProjection> projection,
+                         uint32_t bound_right, std::optional<AVStereo3DType> stereo) {
+  AVFormatContext* input = nullptr;
+  ASSERT_EQ(avformat_open_input(&input, in.c_str(), nullptr, nullptr), 0);
+  ASSERT_GE(avformat_find_stream_info(input, nullptr), 0);
+  AVFormatContext* output = nullptr;
+  ASSERT_GE(avformat_alloc_output_context2(&output, nullptr, "mp4", out.c_str()), 0);
+  AVStream* stream = avformat_new_stream(output, nullptr);
+  ASSERT_NE(stream, nullptr);
+  ASSERT_GE(avcodec_parameters_copy(stream->codecpar, input->streams[0]->codecpar), 0);
+  stream->codecpar->codec_tag = 0;
+  stream->time_base = input->streams[0]->time_base;
+  if (projection) {
+    size_t size = 0;
+    AVSphericalMapping* mapping = av_spherical_alloc(&size);
+    mapping->projection = *projection;
+    mapping->bound_right = bound_right;
+    ASSERT_EQ(av_stream_add_side_data(stream, AV_PKT_DATA_SPHERICAL, reinterpret_cast<uint8_t*>(mapping), size), 0);
+  }
+  if (stereo) {
+    AVStereo3D* s3d = av_stereo3d_alloc();
+    s3d->type = *stereo;
+    ASSERT_EQ(av_stream_add_side_data(stream, AV_PKT_DATA_STEREO3D, reinterpret_cast<uint8_t*>(s3d), sizeof(AVStereo3D)), 0);
+  }
+  output->strict_std_compliance = FF_COMPLIANCE_UNOFFICIAL;
+  ASSERT_GE(avio_open(&output->pb, out.c_str(), AVIO_FLAG_WRITE), 0);
+  ASSERT_GE(avformat_write_header(output, nullptr), 0);
+  AVPacket* packet = av_packet_alloc();
+  while (av_read_frame(input, packet) >= 0) {
+    av_packet_rescale_ts(packet, input->streams[0]->time_base, stream->time_base);
+    packet->stream_index = 0;
+    ASSERT_GE(av_interleaved_write_frame(output, packet), 0);
+  }
+  ASSERT_EQ(av_write_trailer(output), 0);
+  av_packet_free(&packet);
+  avio_closep(&output->pb);
+  avformat_free_context(output);
+  avformat_close_input(&input);
+}
+
+TEST(PanoramaVideo, SphericalMetadataThatIsNotMonoEquirectangularIsRefusedForWhatItSays) {
+  const fs::path dir = test::scratch_dir("panorama-video-metadata");
+  const fs::path plain = make_video(dir, "plain.mp4", 8, "-c:v libx264 -preset veryfast");
+  const auto refused = [&](const fs::path& file, const std::string& expected) {
+    try {
+      PanoramaVideo video(file);
+      ADD_FAILURE() << file << " was accepted";
+    } catch (const AssetError& e) {
+      EXPECT_NE(std::string(e.what()).find(file.string()), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  };
+  // Mono equirectangular, said so: read as before, every frame its own index.
+  remux_with_metadata(plain, dir / "equirect.mp4", AV_SPHERICAL_EQUIRECTANGULAR, 0, AV_STEREO3D_2D);
+  {
+    PanoramaVideo video(dir / "equirect.mp4");
+    PanoramaVideoFrame frame;
+    for (int i = 0; i < 8; ++i) {
+      ASSERT_TRUE(video.next(frame)) << i;
+      EXPECT_EQ(read_barcode(frame), frame.index);
+    }
+  }
+  remux_with_metadata(plain, dir / "cubemap.mp4", AV_SPHERICAL_CUBEMAP, 0, std::nullopt);
+  refused(dir / "cubemap.mp4", "the cubemap projection; only equirectangular");
+  remux_with_metadata(plain, dir / "cropped.mp4", AV_SPHERICAL_EQUIRECTANGULAR_TILE, 1u << 30, std::nullopt);
+  refused(dir / "cropped.mp4", "crops the sphere");
+  remux_with_metadata(plain, dir / "stereo.mp4", std::nullopt, 0, AV_STEREO3D_TOPBOTTOM);
+  refused(dir / "stereo.mp4", "stereo (top and bottom)");
+  fs::remove_all(dir);
 }
 
 }  // namespace
