@@ -57,8 +57,12 @@ void PanoramaPlace::arrive() {
 }
 
 void PanoramaPlace::leave() {
-  if (is_video_) video_.reset();
+  if (!video_) return;
+  skipped_before_ += video_->decode_errors();
+  video_.reset();
 }
+
+uint64_t PanoramaPlace::skipped_video_frames() const { return skipped_before_ + (video_ ? video_->decode_errors() : 0); }
 
 EquirectImage& PanoramaPlace::show_at(int64_t t_ns) {
   if (!is_video_) return *panorama_;

@@ -37,6 +37,8 @@ class PanoramaPlace {
   // The shown video frame's index (presentation order from 0); none for a still.
   std::optional<int64_t> frame_index() const;
   const std::optional<ShRgb9>& light_sh() const { return light_sh_; }
+  // Video frames skipped so far, over every visit: undecodable, or of another size than the stream's.
+  uint64_t skipped_video_frames() const;
   std::string describe() const;
 
  private:
@@ -49,6 +51,7 @@ class PanoramaPlace {
   bool has_upcoming_ = false;
   int64_t loop_offset_ns_ = 0;  // the durations of the passes done
   int64_t video_frame_ns_ = 0;  // one frame at the video's nominal rate
+  uint64_t skipped_before_ = 0;  // by the decoders of earlier visits
   std::unique_ptr<PanoramaLight> light_;     // a video's, for each frame shown
   std::optional<ShRgb9> light_sh_;
 };

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <optional>
 #include <vector>
@@ -47,6 +48,7 @@ struct PanoramaSource::Impl {
   int64_t interval_ns = 0;
   uint64_t next_index = 0;
   PacingClock clock;
+  std::atomic<uint64_t> skipped_video_frames{0}, failed_frames{0};  // for health(), from any thread
 
   // The view's turn at time t_s: the track's (turned right by the view's yaw) at t_s, or the
   // sweep's, which starts again at each viewpoint (since_arrival_s).
@@ -98,6 +100,12 @@ std::optional<int64_t> PanoramaSource::frame_interval_ns() const { return impl_-
 
 void PanoramaSource::interrupt() { impl_->clock.interrupt(); }
 
+std::string PanoramaSource::health() const {
+  const uint64_t skipped = impl_->skipped_video_frames, failed = impl_->failed_frames;
+  if (skipped == 0 && failed == 0) return {};
+  return fmt::format("video frames skipped {} (undecodable or of another size), frames failed {}", skipped, failed);
+}
+
 SourceStatus PanoramaSource::next(Frame& frame) {
   Impl& s = *impl_;
   const PanoramaConfig& panorama = s.config.panorama;
@@ -131,10 +139,14 @@ SourceStatus PanoramaSource::next(Frame& frame) {
     frame.meta.source_frame_index = place.frame_index();
     frame.meta.viewpoint = int(s.here);
     frame.meta.environment_sh = place.light_sh();
+    uint64_t skipped = 0;
+    for (const PanoramaPlace& p : s.places) skipped += p.skipped_video_frames();
+    s.skipped_video_frames = skipped;
     s.next_index = index + 1;
     return SourceStatus::Frame;
   } catch (const std::exception& e) {  // per-frame code never throws (docs/DESIGN.md "Errors")
     log::error("panorama {}: frame {}: {}", panorama.file.string(), index, e.what());
+    ++s.failed_frames;
     s.next_index = index + 1;
     return SourceStatus::Retry;
   }

@@ -29,6 +29,9 @@ class PanoramaSource : public FrameSource {
   // Ends after view.frames frames (never with 0).
   SourceStatus next(Frame& frame) override;
   void interrupt() override;
+  // "video frames skipped N (undecodable or of another size), frames failed M" once either is not
+  // 0 (a frame fails when its video cannot be read back from the start); empty before.
+  std::string health() const override;
 
  private:
   struct Impl;

@@ -275,5 +275,44 @@ TEST(PanoramaVideo, SphericalMetadataThatIsNotMonoEquirectangularIsRefusedForWha
   fs::remove_all(dir);
 }
 
+TEST(PanoramaVideo, FramesOfAnotherSizeAreSkippedCountedAndTheSourceSaysSo) {
+  // One H.264 stream whose middle second is 128 x 64 (in-band headers switch the decoder), in a
+  // Matroska file whose header says 256 x 128: 30 frames of each size, three runs.
+  const fs::path dir = test::scratch_dir("panorama-video-resized");
+  const auto run = [](const std::string& command) { EXPECT_EQ(std::system(command.c_str()), 0) << command; };
+  for (const auto& [name, size] : {std::pair{"a", "256x128"}, {"b", "128x64"}})
+    run(fmt::format("ffmpeg -nostdin -v error -y -f lavfi -i testsrc2=s={}:r=30:d=1 -c:v libx264 -x264-params "
+                    "repeat-headers=1 -bf 0 -pix_fmt yuv420p '{}'", size, (dir / (std::string(name) + ".h264")).string()));
+  run(fmt::format("cd '{}' && cat a.h264 b.h264 a.h264 > c.h264 && ffmpeg -nostdin -v error -y -r 30 -i c.h264 -c copy c.mkv",
+                  dir.string()));
+  {
+    PanoramaVideo video(dir / "c.mkv");
+    PanoramaVideoFrame frame;
+    int delivered = 0;
+    while (video.next(frame)) {
+      EXPECT_EQ(frame.width, 256);
+      EXPECT_EQ(frame.height, 128);
+      ++delivered;
+    }
+    EXPECT_EQ(delivered, 60);
+    EXPECT_EQ(video.decode_errors(), 30u);
+  }
+  // Through the source: every output frame still comes, and its health counts the skipped ones.
+  SourceConfig config;
+  config.type = SourceType::Panorama;
+  config.pacing = ReplayPacing::Fast;
+  config.panorama.file = dir / "c.mkv";
+  config.panorama.view.width = 32;
+  config.panorama.view.height = 16;
+  config.panorama.view.fps = 30;
+  config.panorama.view.frames = 90;
+  PanoramaSource source(config);
+  EXPECT_EQ(source.health(), "");
+  Frame frame;
+  for (int i = 0; i < 90; ++i) ASSERT_EQ(source.next(frame), SourceStatus::Frame) << i;
+  EXPECT_NE(source.health().find("video frames skipped 30"), std::string::npos) << source.health();
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace arpipe
