@@ -633,6 +633,11 @@ void visit(V& v, EnvironmentConfig& s) {
 struct PanoramaLightConfig {
   bool direct_light_from_render = true;  // false: the panorama's SH alone (no direct light, no shadows)
   ShWindow window = ShWindow::None;
+  // The scene's exported lights (a glTF with KHR_lights_punctual) as the direct lights instead of
+  // render.light_*; the brightest casts the shadows. lights_scale turns the file's photometric
+  // units (lux; candela over the squared distance to the world origin) into the render's irradiance.
+  std::filesystem::path lights_file;
+  double lights_scale = 1;
 
   bool operator==(const PanoramaLightConfig&) const = default;
 };
@@ -642,6 +647,10 @@ void visit(V& v, PanoramaLightConfig& s) {
   v.key("direct_light_from_render", s.direct_light_from_render,
         "render.light_direction and light_color as the shadow-casting light; false: the panorama alone (no shadows)");
   v.key("window", s.window, kShWindowNames, "SH windowing against ringing");
+  v.key("lights_file", s.lights_file,
+        "a glTF whose KHR_lights_punctual lights are the direct lights instead of render.light_* (the brightest casts shadows)");
+  v.key("lights_scale", s.lights_scale, NumberRange::open_closed(0, 1e12),
+        "lights_file's lux (directional; candela / distance^2 from the world origin for point and spot) to irradiance");
 }
 
 // The light stage: where the light comes from.

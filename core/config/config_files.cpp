@@ -69,6 +69,8 @@ void check_config_files(const Config& config) {
       if (!proxy.collision_mesh.empty())
         check_regular_file(config, fmt::format("render.proxies[{}].collision_mesh", i), proxy.collision_mesh, "glTF mesh");
     }
+  if (config.light.source == LightSource::Panorama && !config.light.panorama.lights_file.empty())
+    check_regular_file(config, "light.panorama.lights_file", config.light.panorama.lights_file, "glTF lights");
   if (config.light.source == LightSource::Environment || !config.light.environment.file.empty())
     check_regular_file(config, "light.environment.file", config.light.environment.file, "HDR environment");
 }

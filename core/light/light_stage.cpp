@@ -4,11 +4,13 @@
 #include <fmt/format.h>
 #include <time.h>
 
+#include <algorithm>
 #include <numbers>
 #include <optional>
 #include <stdexcept>
 
 #include "core/environment/environment_light.h"
+#include "core/scene/gltf_loader.h"
 #include "core/sh/sh_window.h"
 #include "core/log.h"
 #include "core/pipeline/monotonic_clock.h"
@@ -23,10 +25,53 @@ int64_t realtime_minus_monotonic_ns() {
   return (int64_t(real.tv_sec) - int64_t(mono.tv_sec)) * 1'000'000'000 + (int64_t(real.tv_nsec) - int64_t(mono.tv_nsec));
 }
 
-// The environment's light as the loader read it (light.source = "environment"), else nothing.
+// The environment's light as the loader read it (light.source = "environment"), and the scene's
+// lights for the panorama source (light.panorama.lights_file), strongest first.
 struct EnvironmentAssets final : StageAssets {
   std::optional<LightEstimate> environment;
+  std::vector<DirectionalLight> scene_lights;
 };
+
+// light.panorama.lights_file's lights in the render's units: a directional light's irradiance is its
+// lux times the scale; a point or spot light is a lamp at its place whose irradiance at the world
+// origin is its candela over the squared distance (the spot's cone is not modelled).
+std::vector<DirectionalLight> scene_lights(const Config& config) {
+  const PanoramaLightConfig& c = config.light.panorama;
+  std::vector<GltfLight> file_lights;
+  try {
+    file_lights = load_gltf_lights(c.lights_file);
+  } catch (const std::exception& e) {
+    throw ConfigError(fmt::format("{}: light.panorama.lights_file: {}", config.file.string(), e.what()));
+  }
+  std::vector<DirectionalLight> out;
+  for (const GltfLight& light : file_lights) {
+    DirectionalLight d;
+    // Punctual lights have no size: the penumbra keeps the config's source size.
+    d.angular_diameter_rad = config.render.shadows.light_angular_diameter_deg * std::numbers::pi / 180;
+    if (light.type == "directional") {
+      d.direction_world = -1.0 * light.direction;
+      d.irradiance = (c.lights_scale * light.intensity) * light.color;
+    } else {
+      const double distance = norm(light.position);
+      if (!(distance > 1e-6)) {
+        log::warn("{}: light \"{}\" (node {}) sits at the world origin: left out", c.lights_file.string(), light.name, light.node);
+        continue;
+      }
+      d.local = true;
+      d.position_world = light.position;
+      d.direction_world = (1 / distance) * light.position;
+      d.irradiance = (c.lights_scale * light.intensity / (distance * distance)) * light.color;
+    }
+    out.push_back(d);
+  }
+  if (out.empty())
+    throw ConfigError(fmt::format("{}: light.panorama.lights_file: {} has no KHR_lights_punctual light on its scene's nodes",
+                                  config.file.string(), c.lights_file.string()));
+  std::stable_sort(out.begin(), out.end(), [](const DirectionalLight& a, const DirectionalLight& b) {
+    return std::max({a.irradiance[0], a.irradiance[1], a.irradiance[2]}) > std::max({b.irradiance[0], b.irradiance[1], b.irradiance[2]});
+  });
+  return out;
+}
 
 }  // namespace
 
@@ -34,6 +79,8 @@ StageAssetLoader LightStage::asset_loader() const {
   return [](const Config& config) -> std::shared_ptr<const StageAssets> {
     auto assets = std::make_shared<EnvironmentAssets>();
     if (config.light.source == LightSource::Environment) assets->environment = load_environment_lighting(config).estimate;
+    if (config.light.source == LightSource::Panorama && !config.light.panorama.lights_file.empty())
+      assets->scene_lights = scene_lights(config);
     return assets;
   };
 }
@@ -77,17 +124,22 @@ void LightStage::configure_loaded(const Config& config, const std::shared_ptr<co
   }
   if (light.source == LightSource::Panorama) {
     // The panorama's own light arrives with each frame (FrameMetadata::environment_sh); the direct
-    // light, when kept, is the fixed one (render.light_*), in the same display-referred units.
+    // lights are the scene's (lights_file) or, when kept, the fixed one (render.light_*), in the
+    // same display-referred units.
     panorama_ = PanoramaLighting{};
     panorama_.window = light.panorama.window;
-    if (light.panorama.direct_light_from_render && norm(config.render.light_color) > 0) {
+    panorama_.direct = loaded->scene_lights;
+    if (!light.panorama.lights_file.empty())
+      log::info("light: {} direct light(s) from {}, the strongest casting shadows", panorama_.direct.size(),
+                light.panorama.lights_file.string());
+    else if (light.panorama.direct_light_from_render && norm(config.render.light_color) > 0) {
       DirectionalLight direct;
       direct.direction_world = config.render.light_direction;
       direct.irradiance = std::numbers::pi * config.render.light_color;
       direct.angular_diameter_rad = config.render.shadows.light_angular_diameter_deg * std::numbers::pi / 180;
       direct.local = config.render.light_distance_m > 0;
       direct.position_world = config.render.light_distance_m * config.render.light_direction;
-      panorama_.direct = direct;
+      panorama_.direct = {direct};
     }
   }
   source_ = light.source;
@@ -126,7 +178,7 @@ void LightStage::process(FrameContext& ctx) noexcept {
     ctx.light.ambient_sh = *sh;
     for (size_t i = 0; i < 9; ++i)
       ctx.light.ambient_sh[i] = sh_window_factor(panorama_.window, sh_band(int(i)), 3) * ctx.light.ambient_sh[i];
-    if (panorama_.direct) ctx.light.lights.push_back(*panorama_.direct);
+    ctx.light.lights = panorama_.direct;
     ctx.light.scene_linear = true;
     ctx.light.confidence = 1;
     ctx.record_timing(std::string(name()), milliseconds_since(start), "the panorama's image");

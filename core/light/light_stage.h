@@ -8,6 +8,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "core/config/light_source.h"
 #include "core/light/ground_radiance.h"
@@ -38,7 +39,7 @@ class LightStage final : public Stage {
   std::unique_ptr<SunLight> sun_;
   LightEstimate environment_;  // Environment: the same every frame
   struct PanoramaLighting {
-    std::optional<DirectionalLight> direct;  // render.light_*, unless direct_light_from_render is off
+    std::vector<DirectionalLight> direct;  // lights_file's, else render.light_* unless direct_light_from_render is off
     ShWindow window = ShWindow::None;
   } panorama_;                   // Panorama: with the SH each frame brings
   Vec3 probe_centre_{0, 0, 0};

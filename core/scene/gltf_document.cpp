@@ -4,7 +4,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstring>
 #include <nlohmann/json.hpp>
 #include <string_view>
@@ -156,7 +158,9 @@ class DocumentReader {
       fail(fmt::format("not a valid glTF 2.0 {} file: the JSON is not an object",
                        document_.binary ? "binary (.glb)" : "JSON"));
     for (const char* unused : {"images", "textures", "samplers", "animations", "skins", "cameras"}) gltf.erase(unused);
+    const PunctualLights lights = take_punctual_lights(gltf);
     drop_extras_and_extensions(gltf);
+    put_punctual_lights(gltf, lights);
     for (const char* name : {"nodes", "meshes", "accessors", "bufferViews", "buffers", "materials", "scenes"}) {
       const auto it = gltf.find(name);
       if (it != gltf.end() && it->is_array() && it->size() > kMaxGltfArrayEntries)
@@ -173,6 +177,86 @@ class DocumentReader {
       }
     check_buffers(gltf);
     return gltf.dump();
+  }
+
+  // KHR_lights_punctual is the one extension kept (the scene's lights, load_gltf_lights): checked
+  // here and rebuilt from its known fields only, so nothing else of it reaches tinygltf.
+  struct PunctualLights {
+    json lights = json::array();
+    std::vector<std::pair<size_t, int64_t>> node_lights;  // node index, light index
+  };
+
+  PunctualLights take_punctual_lights(const json& gltf) const {
+    PunctualLights out;
+    const auto number = [](const json& v) { return v.is_number() && std::isfinite(v.get<double>()); };
+    if (const auto extensions = gltf.find("extensions"); extensions != gltf.end() && extensions->is_object())
+      if (const auto khr = extensions->find("KHR_lights_punctual"); khr != extensions->end() && khr->is_object())
+        if (const auto lights = khr->find("lights"); lights != khr->end() && lights->is_array()) {
+          if (lights->size() > kMaxGltfLights)
+            fail(fmt::format("KHR_lights_punctual has {} lights, over the limit of {}", lights->size(), kMaxGltfLights));
+          for (size_t i = 0; i < lights->size(); ++i) {
+            const json& light = (*lights)[i];
+            const auto bad = [&](const std::string& what) { fail(fmt::format("KHR_lights_punctual light {}: {}", i, what)); };
+            if (!light.is_object()) bad("not an object");
+            json kept = json::object();
+            const auto type = light.find("type");
+            if (type == light.end() || !type->is_string() ||
+                (*type != "directional" && *type != "point" && *type != "spot"))
+              bad("\"type\" must be \"directional\", \"point\" or \"spot\"");
+            kept["type"] = *type;
+            if (const auto name = light.find("name"); name != light.end() && name->is_string())
+              kept["name"] = name->get<std::string>().substr(0, 200);
+            if (const auto color = light.find("color"); color != light.end()) {
+              if (!color->is_array() || color->size() != 3 || !std::all_of(color->begin(), color->end(), [&](const json& c) {
+                    return number(c) && c.get<double>() >= 0;
+                  }))
+                bad("\"color\" must be 3 numbers >= 0");
+              kept["color"] = *color;
+            }
+            if (const auto intensity = light.find("intensity"); intensity != light.end()) {
+              if (!number(*intensity) || intensity->get<double>() < 0) bad("\"intensity\" must be a number >= 0");
+              kept["intensity"] = *intensity;
+            }
+            if (const auto range = light.find("range"); range != light.end()) {
+              if (!number(*range) || range->get<double>() <= 0) bad("\"range\" must be a number > 0");
+              kept["range"] = *range;
+            }
+            if (*type == "spot") {
+              json cone = json::object();
+              if (const auto spot = light.find("spot"); spot != light.end() && spot->is_object())
+                for (const char* key : {"innerConeAngle", "outerConeAngle"})
+                  if (const auto angle = spot->find(key); angle != spot->end()) {
+                    if (!number(*angle)) bad(fmt::format("\"spot\".\"{}\" must be a number", key));
+                    cone[key] = *angle;
+                  }
+              kept["spot"] = cone;
+            }
+            out.lights.push_back(std::move(kept));
+          }
+        }
+    if (const auto nodes = gltf.find("nodes"); nodes != gltf.end() && nodes->is_array())
+      for (size_t n = 0; n < nodes->size(); ++n) {
+        const json& node = (*nodes)[n];
+        if (!node.is_object()) continue;
+        const auto extensions = node.find("extensions");
+        if (extensions == node.end() || !extensions->is_object()) continue;
+        const auto khr = extensions->find("KHR_lights_punctual");
+        if (khr == extensions->end() || !khr->is_object()) continue;
+        const auto light = khr->find("light");
+        if (light == khr->end()) continue;
+        if (!light->is_number_integer() || light->get<int64_t>() < 0 || light->get<int64_t>() >= int64_t(out.lights.size()))
+          fail(fmt::format("node {}: its KHR_lights_punctual light {} does not exist ({} lights)", n, light->dump(),
+                           out.lights.size()));
+        out.node_lights.emplace_back(n, light->get<int64_t>());
+      }
+    return out;
+  }
+
+  static void put_punctual_lights(json& gltf, const PunctualLights& lights) {
+    if (lights.lights.empty()) return;
+    gltf["extensions"] = {{"KHR_lights_punctual", {{"lights", lights.lights}}}};
+    for (const auto& [node, light] : lights.node_lights)
+      gltf["nodes"][node]["extensions"] = {{"KHR_lights_punctual", {{"light", light}}}};
   }
 
   // "extras" and "extensions" anywhere: iteratively, with a stack of the objects still to visit.

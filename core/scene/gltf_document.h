@@ -20,7 +20,9 @@ struct GltfDocument {
 // arrays within kMaxGltfArrayEntries, the buffers' declared bytes within kMaxGltfBufferBytes, every
 // external buffer a regular file inside the folder of its declared byteLength. Images, textures,
 // samplers, animations, skins, cameras, "extras" and "extensions" are dropped: the loader uses
-// none of them, and tinygltf would recurse over or allocate for them. Throws AssetError naming the
+// none of them, and tinygltf would recurse over or allocate for them. The one extension kept is
+// KHR_lights_punctual (within kMaxGltfLights), checked and rebuilt from its known fields: type,
+// name, color, intensity, range, the spot's cone angles and each node's light index. Throws AssetError naming the
 // file and the place (byte offset, buffer index, array).
 GltfDocument read_gltf_document(const std::filesystem::path& path);
 

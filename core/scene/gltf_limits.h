@@ -20,6 +20,8 @@ inline constexpr int kMaxGltfJsonDepth = 64;
 // Entries of each top-level array (nodes, meshes, accessors, bufferViews, buffers, materials,
 // scenes) and primitives per mesh.
 inline constexpr size_t kMaxGltfArrayEntries = 1'000'000;
+// KHR_lights_punctual lights (the scene's lights, gltf_loader.h load_gltf_lights).
+inline constexpr size_t kMaxGltfLights = 1024;
 // Node hierarchy depth (the walk is iterative; the limit keeps the walk's own stack small).
 inline constexpr size_t kMaxGltfNodeDepth = 1024;
 // The one mesh the loader returns (every node's instance of a mesh counts again).

@@ -117,8 +117,11 @@ bool all_finite(const glm::dmat3& m) {
 
 class GltfMeshCollector {
  public:
-  GltfMeshCollector(const tinygltf::Model& model, const std::filesystem::path& path)
-      : model_(model), path_(path), reached_(model.nodes.size(), false) {}
+  // read_meshes false: only the lights are collected (load_gltf_lights).
+  GltfMeshCollector(const tinygltf::Model& model, const std::filesystem::path& path, bool read_meshes = true)
+      : model_(model), path_(path), reached_(model.nodes.size(), false), read_meshes_(read_meshes) {}
+
+  std::vector<GltfLight> take_lights() { return std::move(lights_); }
 
   // The node hierarchy under `roots`, walked depth-first with an explicit stack (no recursion over
   // the file's graph). glTF nodes form strict trees: a node reached a second time (two parents,
@@ -149,7 +152,8 @@ class GltfMeshCollector {
       const glm::dmat4 transform = pending.parent * node_transform(node_index, node);
       if (!all_finite(transform))
         fail(fmt::format("node {}: its transform combined with its parents' is not finite (overflow)", node_index));
-      if (node.mesh >= 0) add_mesh(node_index, node.mesh, transform);
+      if (node.mesh >= 0 && read_meshes_) add_mesh(node_index, node.mesh, transform);
+      add_light(node_index, node, transform);
       for (auto child = node.children.rbegin(); child != node.children.rend(); ++child)
         stack.push_back({*child, transform, pending.depth + 1});
     }
@@ -180,6 +184,34 @@ class GltfMeshCollector {
       transform *= glm::mat4_cast(glm::dquat(node.rotation[3], node.rotation[0], node.rotation[1], node.rotation[2]));
     if (node.scale.size() == 3) transform = glm::scale(transform, glm::dvec3(node.scale[0], node.scale[1], node.scale[2]));
     return transform;
+  }
+
+  // The node's KHR_lights_punctual light (gltf_document.cpp checked its index), placed: at the
+  // node's origin, shining along its -z, in the z-up frame.
+  void add_light(int node_index, const tinygltf::Node& node, const glm::dmat4& transform) {
+    const auto extension = node.extensions.find("KHR_lights_punctual");
+    if (extension == node.extensions.end() || !extension->second.Has("light")) return;
+    const int index = extension->second.Get("light").GetNumberAsInt();
+    if (index < 0 || static_cast<size_t>(index) >= model_.lights.size())
+      fail(fmt::format("node {} names light {}, which does not exist", node_index, index));
+    const tinygltf::Light& light = model_.lights[static_cast<size_t>(index)];
+    const auto to_object_frame = [](const glm::dvec3& v) { return glm::dvec3(v.x, -v.z, v.y); };
+    const glm::dvec3 position = to_object_frame(glm::dvec3(transform * glm::dvec4(0, 0, 0, 1)));
+    glm::dvec3 direction = to_object_frame(glm::dmat3(transform) * glm::dvec3(0, 0, -1));
+    const double length = glm::length(direction);
+    if (!(length > 1e-100) || !std::isfinite(length) || !std::isfinite(position.x + position.y + position.z))
+      fail(fmt::format("node {}: light {} has no direction or position (a zero or infinite scale)", node_index, index));
+    direction /= length;
+    GltfLight out;
+    out.name = light.name;
+    out.type = light.type;
+    if (light.color.size() == 3) out.color = {light.color[0], light.color[1], light.color[2]};
+    out.intensity = light.intensity;
+    out.range = light.range;
+    out.position = {position.x, position.y, position.z};
+    out.direction = {direction.x, direction.y, direction.z};
+    out.node = node_index;
+    lights_.push_back(std::move(out));
   }
 
   void add_mesh(int node_index, int mesh_index, const glm::dmat4& transform) {
@@ -447,6 +479,8 @@ class GltfMeshCollector {
   const std::filesystem::path& path_;
   std::vector<bool> reached_;  // per node: already placed once
   Mesh mesh_;
+  bool read_meshes_ = true;
+  std::vector<GltfLight> lights_;
   int skipped_primitives_ = 0;
   int skipped_singular_ = 0;
   uint64_t elements_read_ = 0;
@@ -468,7 +502,7 @@ std::vector<int> root_nodes(const tinygltf::Model& model) {
   return roots;
 }
 
-Mesh load_checked_gltf_mesh(const std::filesystem::path& path) {
+tinygltf::Model load_checked_gltf_model(const std::filesystem::path& path) {
   GltfDocument document = read_gltf_document(path);
   ExternalFiles external{document.folder, kMaxGltfBufferBytes};
   tinygltf::TinyGLTF loader;
@@ -489,19 +523,15 @@ Mesh load_checked_gltf_mesh(const std::filesystem::path& path) {
     throw AssetError(fmt::format("{}: not a valid glTF 2.0 {} file: {}", path.string(),
                                  binary ? "binary (.glb)" : "JSON", tinygltf_message(error)));
   if (!warning.empty()) log::debug("{}: tinygltf: {}", path.string(), tinygltf_message(warning));
-
-  GltfMeshCollector collector(model, path);
-  collector.add_roots(root_nodes(model));
-  return collector.finish();
+  return model;
 }
 
-}  // namespace
-
-Mesh load_gltf_mesh(const std::filesystem::path& path) {
-  // Every failure is an AssetError naming the file: the limits above keep allocations small, and
-  // this is the last line for what they do not foresee.
+// Every failure an AssetError naming the file: the limits above keep allocations small, and this is
+// the last line for what they do not foresee.
+template <class F>
+auto as_asset_errors(const std::filesystem::path& path, F load) {
   try {
-    return load_checked_gltf_mesh(path);
+    return load();
   } catch (const AssetError&) {
     throw;
   } catch (const std::bad_alloc&) {
@@ -509,6 +539,26 @@ Mesh load_gltf_mesh(const std::filesystem::path& path) {
   } catch (const std::exception& e) {
     throw AssetError(fmt::format("{}: cannot load the glTF file: {}", path.string(), e.what()));
   }
+}
+
+}  // namespace
+
+Mesh load_gltf_mesh(const std::filesystem::path& path) {
+  return as_asset_errors(path, [&] {
+    const tinygltf::Model model = load_checked_gltf_model(path);
+    GltfMeshCollector collector(model, path);
+    collector.add_roots(root_nodes(model));
+    return collector.finish();
+  });
+}
+
+std::vector<GltfLight> load_gltf_lights(const std::filesystem::path& path) {
+  return as_asset_errors(path, [&] {
+    const tinygltf::Model model = load_checked_gltf_model(path);
+    GltfMeshCollector collector(model, path, false);
+    collector.add_roots(root_nodes(model));
+    return collector.take_lights();
+  });
 }
 
 }  // namespace arpipe

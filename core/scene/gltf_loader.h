@@ -3,7 +3,10 @@
 #pragma once
 
 #include <filesystem>
+#include <string>
+#include <vector>
 
+#include "core/geometry/vec.h"
 #include "core/scene/mesh.h"
 
 namespace arpipe {
@@ -23,5 +26,21 @@ namespace arpipe {
 // file, JSON or GLB syntax, a limit (stated in the message), a bad accessor (naming the mesh,
 // primitive, attribute and accessor), a bad node (naming it), no triangles at all.
 Mesh load_gltf_mesh(const std::filesystem::path& path);
+
+// A KHR_lights_punctual light of the scene, placed by its node (z-up, as the meshes).
+struct GltfLight {
+  std::string name;
+  std::string type;           // "directional", "point" or "spot"
+  Vec3 color{1, 1, 1};        // linear RGB
+  double intensity = 1;       // directional: lux (lm/m^2); point and spot: candela (lm/sr)
+  double range = 0;           // 0: without limit
+  Vec3 position{0, 0, 0};     // point and spot: where it is
+  Vec3 direction{0, 0, -1};   // directional and spot: the way it shines (unit; the node's -z)
+  int node = -1;
+};
+
+// The lights on the nodes of the scene that load_gltf_mesh walks (the same file checks and node
+// rules; meshes are not read). Empty when the file has none. Throws AssetError naming the file.
+std::vector<GltfLight> load_gltf_lights(const std::filesystem::path& path);
 
 }  // namespace arpipe

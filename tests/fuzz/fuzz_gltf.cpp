@@ -1,5 +1,6 @@
-// libFuzzer target: core/scene's glTF 2.0 loader (load_gltf_mesh) on a .gltf (JSON) or .glb
-// file. Bad input must be an AssetError; a loaded mesh must be consistent (indices in range).
+// libFuzzer target: core/scene's glTF 2.0 loader (load_gltf_mesh, load_gltf_lights) on a .gltf
+// (JSON) or .glb file. Bad input must be an AssetError; a loaded mesh must be consistent (indices in
+// range), a loaded light finite with a unit direction.
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -28,6 +29,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::filesystem::path file = arpipe::fuzz::write_temp_file("model.gltf", data, size);
   try {
     check_mesh(arpipe::load_gltf_mesh(file));
+  } catch (const arpipe::AssetError&) {
+  }
+  try {
+    for (const arpipe::GltfLight& light : arpipe::load_gltf_lights(file)) {
+      ARPIPE_FUZZ_CHECK(std::abs(arpipe::norm(light.direction) - 1) < 1e-9, "a unit direction");
+      ARPIPE_FUZZ_CHECK(std::isfinite(light.position[0] + light.position[1] + light.position[2]), "a finite position");
+      ARPIPE_FUZZ_CHECK(light.intensity >= 0 && std::isfinite(light.intensity), "a finite intensity >= 0");
+    }
   } catch (const arpipe::AssetError&) {
   }
   return 0;

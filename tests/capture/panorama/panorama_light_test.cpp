@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <numbers>
 #include <opencv2/imgcodecs.hpp>
 
@@ -149,6 +150,53 @@ TEST(PanoramaLight, TheSourceCarriesItAndTheLightStagePassesItOn) {
   stage.process(ctx);
   EXPECT_EQ(ctx.light.state, LightState::None);
   EXPECT_FALSE(ctx.light.note.empty());
+}
+
+TEST(PanoramaLight, TheScenesExportedLightsAreTheDirectLightsStrongestFirst) {
+  // light.panorama.lights_file: a sun shining straight down at 3 lux and a 20 cd lamp at (1, -3, 3)
+  // (19 m^2 from the origin), times lights_scale 0.5: the sun (1.5, 1.35, 1.2) first, towards +z;
+  // the lamp a local light there, 0.5 x 20 / 19 at the origin.
+  const auto dir = test::scratch_dir("panorama-scene-lights");
+  std::ofstream(dir / "lights.gltf") << R"({"asset": {"version": "2.0"},
+    "extensions": {"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 20.0},
+                                                      {"type": "directional", "color": [1.0, 0.9, 0.8], "intensity": 3.0}]}},
+    "scenes": [{"nodes": [0, 1]}],
+    "nodes": [{"translation": [1.0, 3.0, 3.0], "extensions": {"KHR_lights_punctual": {"light": 0}}},
+              {"rotation": [-0.7071067811865476, 0.0, 0.0, 0.7071067811865476], "extensions": {"KHR_lights_punctual": {"light": 1}}}]})";
+  Config config;
+  config.source.type = SourceType::Panorama;
+  config.light.source = LightSource::Panorama;
+  config.light.panorama.lights_file = dir / "lights.gltf";
+  config.light.panorama.lights_scale = 0.5;
+  config.render.shadows.light_angular_diameter_deg = 0.5;
+  LightStage stage;
+  stage.configure(config);
+  FrameContext ctx;
+  ctx.camera.meta.environment_sh = ShRgb9{};
+  stage.process(ctx);
+  ASSERT_EQ(ctx.light.lights.size(), 2u);
+  const DirectionalLight& sun = ctx.light.lights[0];
+  EXPECT_FALSE(sun.local);
+  EXPECT_NEAR(sun.direction_world[2], 1, 1e-12);
+  EXPECT_NEAR(sun.irradiance[0], 1.5, 1e-12);
+  EXPECT_NEAR(sun.irradiance[2], 1.2, 1e-12);
+  EXPECT_NEAR(sun.angular_diameter_rad, 0.5 * kPi / 180, 1e-15);
+  const DirectionalLight& lamp = ctx.light.lights[1];
+  EXPECT_TRUE(lamp.local);
+  EXPECT_NEAR(lamp.position_world[0], 1, 1e-12);
+  EXPECT_NEAR(lamp.position_world[1], -3, 1e-12);
+  EXPECT_NEAR(lamp.position_world[2], 3, 1e-12);
+  EXPECT_NEAR(norm(lamp.direction_world), 1, 1e-12);
+  EXPECT_NEAR(lamp.irradiance[1], 0.5 * 20 / 19, 1e-12);
+  // A file without lights is a setup error naming the key.
+  std::ofstream(dir / "none.gltf") << R"({"asset": {"version": "2.0"}, "nodes": [{}]})";
+  config.light.panorama.lights_file = dir / "none.gltf";
+  try {
+    stage.configure(config);
+    ADD_FAILURE() << "a lights file without lights was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("light.panorama.lights_file"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
