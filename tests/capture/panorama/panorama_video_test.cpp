@@ -175,17 +175,19 @@ TEST(PanoramaVideo, TheSourceShowsEachOutputFrameTheVideoFrameOfItsTime) {
   EXPECT_EQ(source.next(frame), SourceStatus::EndOfStream);
 }
 
+// Opening `file` must fail with an AssetError naming it and saying `expected`.
+void refused(const fs::path& file, const std::string& expected) {
+  try {
+    PanoramaVideo video(file);
+    ADD_FAILURE() << file << " was accepted";
+  } catch (const AssetError& e) {
+    EXPECT_NE(std::string(e.what()).find(file.string()), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+  }
+}
+
 TEST(PanoramaVideo, BadFilesAreRefusedNamingThem) {
   const fs::path dir = test::scratch_dir("panorama-video-bad");
-  const auto refused = [](const fs::path& file, const std::string& expected) {
-    try {
-      PanoramaVideo video(file);
-      ADD_FAILURE() << file << " was accepted";
-    } catch (const AssetError& e) {
-      EXPECT_NE(std::string(e.what()).find(file.string()), std::string::npos) << e.what();
-      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
-    }
-  };
   refused(dir / "missing.mp4", "no such file");
   std::ofstream(dir / "text.mp4") << "not a video\n";
   refused(dir / "text.mp4", "cannot open");
@@ -247,15 +249,6 @@ void remux_with_metadata(const fs::path& in, const fs::path& out, std::optional<
 TEST(PanoramaVideo, SphericalMetadataThatIsNotMonoEquirectangularIsRefusedForWhatItSays) {
   const fs::path dir = test::scratch_dir("panorama-video-metadata");
   const fs::path plain = make_video(dir, "plain.mp4", 8, "-c:v libx264 -preset veryfast");
-  const auto refused = [&](const fs::path& file, const std::string& expected) {
-    try {
-      PanoramaVideo video(file);
-      ADD_FAILURE() << file << " was accepted";
-    } catch (const AssetError& e) {
-      EXPECT_NE(std::string(e.what()).find(file.string()), std::string::npos) << e.what();
-      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
-    }
-  };
   // Mono equirectangular, said so: read as before, every frame its own index.
   remux_with_metadata(plain, dir / "equirect.mp4", AV_SPHERICAL_EQUIRECTANGULAR, 0, AV_STEREO3D_2D);
   {
