@@ -53,8 +53,14 @@ void check_config_files(const Config& config) {
   if (config.source.type == SourceType::Replay) check_recording_dir(config, config.source.path);
   if (!config.source.camera_model.empty())
     check_regular_file(config, "source.camera_model", config.source.camera_model, "camera model");
-  if (config.source.type == SourceType::Panorama && !config.source.panorama.view.track.empty())
-    check_regular_file(config, "source.panorama.view.track", config.source.panorama.view.track, "head-pose track");
+  if (config.source.type == SourceType::Panorama) {
+    check_regular_file(config, "source.panorama.file", config.source.panorama.file, "panorama");
+    for (size_t i = 0; i < config.source.panorama.viewpoints.size(); ++i)
+      check_regular_file(config, fmt::format("source.panorama.viewpoints[{}].file", i), config.source.panorama.viewpoints[i].file,
+                         "panorama");
+    if (!config.source.panorama.view.track.empty())
+      check_regular_file(config, "source.panorama.view.track", config.source.panorama.view.track, "head-pose track");
+  }
   if (config.render.enabled)
     for (size_t i = 0; i < config.render.objects.size(); ++i) {
       const std::string& mesh = config.render.objects[i].mesh;

@@ -121,6 +121,18 @@ TEST_F(ConfigFiles, EveryNamedInputMustExistAndBeARegularFile) {
             "c.toml: source.path: " + (dir_ / "nothing").string() + ": no such directory, expected a recording directory");
   EXPECT_EQ(files_error(source() + "[light]\nsource = \"environment\"\n[light.environment]\nfile = \"/dev/zero\"\n"),
             "c.toml: light.environment.file: /dev/zero: it is a character device, expected a regular file");
+  // A panorama source: its still, every viewpoint's and the head track; the scene's lights file.
+  const std::string panorama = "[source]\ntype = \"panorama\"\n[source.panorama]\nfile = \"" + (dir_ / "mesh.gltf").string() + "\"\n";
+  EXPECT_EQ(files_error(panorama), "");
+  EXPECT_EQ(files_error("[source]\ntype = \"panorama\"\n[source.panorama]\nfile = \"" + (dir_ / "absent.png").string() + "\"\n"),
+            "c.toml: source.panorama.file: " + (dir_ / "absent.png").string() + ": No such file or directory");
+  EXPECT_EQ(files_error(panorama + "[[source.panorama.viewpoints]]\nfile = \"" + dir_.string() +
+                        "\"\n[source.panorama.view]\ndwell_s = 1.0\n"),
+            "c.toml: source.panorama.viewpoints[0].file: " + dir_.string() + ": it is a directory, expected a regular file");
+  EXPECT_EQ(files_error(panorama + "[source.panorama.view]\ntrack = \"" + (dir_ / "absent.csv").string() + "\"\n"),
+            "c.toml: source.panorama.view.track: " + (dir_ / "absent.csv").string() + ": No such file or directory");
+  EXPECT_EQ(files_error(panorama + "[light]\nsource = \"panorama\"\n[light.panorama]\nlights_file = \"/dev/zero\"\n"),
+            "c.toml: light.panorama.lights_file: /dev/zero: it is a character device, expected a regular file");
   // The defaults name no recording: nothing to check (starting the replay says source.path is empty).
   EXPECT_EQ(files_error(""), "");
   // A disabled renderer loads no meshes.
