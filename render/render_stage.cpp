@@ -234,6 +234,7 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
     motion.T_cam_world_start = motion.T_cam_world_mid = motion.T_cam_world_end = ctx.pose.T_cam_world;
     motion.max_image_motion_px = 0;
   }
+  if (physics_) physics_->set_viewpoint(ctx.camera.meta.viewpoint);  // its proxies' colliders only
   if (physics_ && move_objects(motion)) reuse_.forget();
   if (physics_) {
     PhysicsReport report;

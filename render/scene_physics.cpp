@@ -127,6 +127,7 @@ ScenePhysics::ScenePhysics(const Config& config, const LoadedMeshes& meshes)
     ground.name = "ground (render.physics.ground)";
     ground.T_world_collider = shifted({0, 0, render.shadows.receiver_height_m});
     colliders_.push_back(ground);
+    collider_viewpoint_.push_back(-1);
   }
   for (size_t i = 0; i < render.proxies.size() && i < meshes.proxies.size(); ++i) {
     const SceneProxy& proxy = render.proxies[i];
@@ -158,6 +159,7 @@ ScenePhysics::ScenePhysics(const Config& config, const LoadedMeshes& meshes)
       spec.shape = primitive_shape<ColliderShape>(primitive, mesh, proxy.scale, T_proxy_shape);
     spec.T_world_collider = T_world_proxy * T_proxy_shape;
     colliders_.push_back(std::move(spec));
+    collider_viewpoint_.push_back(proxy.viewpoint);
   }
   // Every spec is checked now, where the config's name can go into the message: a trial world
   // takes them all (Bullet builds each shape; a 10k-triangle proxy takes milliseconds).
@@ -182,6 +184,14 @@ void ScenePhysics::build(int64_t t0_ns) {
   world->start(t0_ns);
   world_ = std::move(world);
   start_ns_ = t0_ns;
+  set_viewpoint(viewpoint_);
+}
+
+void ScenePhysics::set_viewpoint(const std::optional<int>& viewpoint) {
+  viewpoint_ = viewpoint;
+  if (!world_) return;
+  for (size_t i = 0; i < collider_viewpoint_.size(); ++i)
+    world_->set_collider_enabled(i, collider_viewpoint_[i] < 0 || !viewpoint || collider_viewpoint_[i] == *viewpoint);
 }
 
 void ScenePhysics::advance(int64_t exposure_start_ns, int64_t end_ns) {

@@ -26,6 +26,10 @@ class ScenePhysics {
   // at its exposure start; a frame that starts before the previous one did (a replay from its
   // beginning again) builds it afresh there, so the same frames give the same trajectory.
   void advance(int64_t exposure_start_ns, int64_t end_ns);
+  // The panorama viewpoint the next frames show (FrameMetadata::viewpoint): a proxy of another
+  // viewpoint (render.proxies.viewpoint) stops nothing until the view comes back. Frames without
+  // one: every collider.
+  void set_viewpoint(const std::optional<int>& viewpoint);
   // The object's state at t; nullopt for an object without physics or before the first advance.
   std::optional<BodySample> sample(size_t object_index, int64_t t_ns) const;
   const RigidWorldStats* stats() const { return world_ ? &world_->stats() : nullptr; }
@@ -40,6 +44,8 @@ class ScenePhysics {
 
   RigidWorldSettings settings_;
   std::vector<ColliderSpec> colliders_;
+  std::vector<int> collider_viewpoint_;  // per collider: its proxy's viewpoint; -1 every one
+  std::optional<int> viewpoint_;
   std::vector<Body> bodies_;
   std::vector<std::optional<size_t>> body_of_object_;  // per render.objects entry
   std::unique_ptr<RigidWorld> world_;

@@ -310,7 +310,7 @@ struct SceneProxy {
   double restitution = 1.0;            // 1: the body's own restitution applies (combined by product)
   double friction = 1.0;
   // A panorama source's viewpoint this proxy stands in (source.panorama: 0 its own table, k the
-  // k-th [[source.panorama.viewpoints]]); -1: every frame. Colliders stay in the physics throughout.
+  // k-th [[source.panorama.viewpoints]]); -1: every frame. Its collider, too, stops bodies only there.
   int viewpoint = -1;
 
   bool operator==(const SceneProxy&) const = default;

@@ -90,6 +90,7 @@ struct RigidWorld::Impl {
   struct Collider {
     BulletShape shape;
     std::unique_ptr<btCollisionObject> object;
+    bool enabled = true;  // in the Bullet world
   };
 
   explicit Impl(const RigidWorldSettings& s)
@@ -119,7 +120,8 @@ struct RigidWorld::Impl {
   ~Impl() {
     for (Body& b : bodies)
       if (b.removed == RemovalReason::None) world.removeRigidBody(b.rigid.get());
-    for (Collider& c : colliders) world.removeCollisionObject(c.object.get());
+    for (Collider& c : colliders)
+      if (c.enabled) world.removeCollisionObject(c.object.get());
   }
 
   // Kinematic bodies: where the track puts them at t. `teleport`: also as their previous pose, so
@@ -228,6 +230,11 @@ const RigidWorldSettings& checked_world_settings(const RigidWorldSettings& s) {
   check_world_settings(s);
   return s;
 }
+
+// A static collider: it meets everything but other static ones.
+void add_static(btDiscreteDynamicsWorld& world, btCollisionObject* object) {
+  world.addCollisionObject(object, btBroadphaseProxy::StaticFilter, btBroadphaseProxy::AllFilter ^ btBroadphaseProxy::StaticFilter);
+}
 }  // namespace
 
 RigidWorld::RigidWorld(const RigidWorldSettings& settings)
@@ -255,8 +262,7 @@ size_t RigidWorld::add_collider(const ColliderSpec& spec) {
   c.object->setRestitution(static_cast<btScalar>(spec.restitution));
   c.object->setFriction(static_cast<btScalar>(spec.friction));
   c.object->setRollingFriction(static_cast<btScalar>(spec.rolling_friction));
-  w.world.addCollisionObject(c.object.get(), btBroadphaseProxy::StaticFilter,
-                             btBroadphaseProxy::AllFilter ^ btBroadphaseProxy::StaticFilter);
+  add_static(w.world, c.object.get());
   w.stats.triangles += triangles;
   w.stats.degenerate_triangles += c.shape.degenerate_triangles;
   w.colliders.push_back(std::move(c));
@@ -395,6 +401,16 @@ int64_t RigidWorld::oldest_ns() const { return impl_->history.oldest_ns(); }
 int64_t RigidWorld::newest_ns() const { return impl_->history.newest_ns(); }
 size_t RigidWorld::body_count() const { return impl_->bodies.size(); }
 size_t RigidWorld::collider_count() const { return impl_->colliders.size(); }
+
+void RigidWorld::set_collider_enabled(size_t collider, bool enabled) {
+  Impl::Collider& c = impl_->colliders.at(collider);
+  if (c.enabled == enabled) return;
+  if (enabled)
+    add_static(impl_->world, c.object.get());
+  else
+    impl_->world.removeCollisionObject(c.object.get());
+  c.enabled = enabled;
+}
 const RigidWorldStats& RigidWorld::stats() const { return impl_->stats; }
 const RigidWorldSettings& RigidWorld::settings() const { return impl_->settings; }
 

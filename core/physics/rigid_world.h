@@ -81,6 +81,10 @@ class RigidWorld {
   int64_t newest_ns() const;
   size_t body_count() const;
   size_t collider_count() const;
+  // Takes a collider out of the world (false) or puts it back (true) from the next substep on: a
+  // proxy of a panorama viewpoint the view has left stops nothing. Every collider starts enabled.
+  // Throws std::out_of_range for an index add_collider never returned.
+  void set_collider_enabled(size_t collider, bool enabled);
   const RigidWorldStats& stats() const;
   const RigidWorldSettings& settings() const;
 
