@@ -56,18 +56,25 @@ TEST(ScenePhysics, DroppedBallLandsWhenFreeFallSays) {
   EXPECT_NEAR(falling->T_world_body.translation()[2], 0.5 - 0.5 * kG * t * t - 0.5 * kG * t * dt, 2e-4);
 }
 
-// Scene C: a ball thrown at a real box bounces off its face. Without gravity (and no ground) the
-// closed form is simple: it reaches the face at x = face - r, and comes back at e times its speed.
-TEST(ScenePhysics, ThrownBallBouncesOffAProxyBox) {
+// A ball thrown at 2 m/s along x, without gravity or ground, at a real box whose -x face is at
+// x = 0.4 (a proxy of `viewpoint`).
+Config thrown_at_box_config(int viewpoint) {
   Config config = ball_config({0, 0, 0.1}, {2.0, 0, 0}, 0.8);
   config.render.physics.gravity_mps2 = {0, 0, 0};
   config.render.physics.ground = false;
   SceneProxy box;
   box.mesh = "builtin:box";
   box.size_m = {0.2, 0.4, 0.4};
-  box.position_m = {0.5, 0, 0};  // its -x face at x = 0.4
-  box.roles = ProxyRoles{true, true, true, true};
+  box.position_m = {0.5, 0, 0};
+  box.viewpoint = viewpoint;
   config.render.proxies = {box};
+  return config;
+}
+
+// Scene C: a ball thrown at a real box bounces off its face. Without gravity (and no ground) the
+// closed form is simple: it reaches the face at x = face - r, and comes back at e times its speed.
+TEST(ScenePhysics, ThrownBallBouncesOffAProxyBox) {
+  const Config config = thrown_at_box_config(-1);
   ScenePhysics physics(config, load_object_meshes(config));
   run_frames(physics, 0.4);
   const double hit_s = (0.4 - 0.03) / 2.0;
@@ -84,15 +91,7 @@ TEST(ScenePhysics, ThrownBallBouncesOffAProxyBox) {
 // A proxy of one panorama viewpoint (render.proxies.viewpoint) stops bodies only while the view is
 // there: at another viewpoint the thrown ball flies on through where the box stands.
 TEST(ScenePhysics, AProxyStopsBodiesOnlyAtItsOwnViewpoint) {
-  Config config = ball_config({0, 0, 0.1}, {2.0, 0, 0}, 0.8);
-  config.render.physics.gravity_mps2 = {0, 0, 0};
-  config.render.physics.ground = false;
-  SceneProxy box;
-  box.mesh = "builtin:box";
-  box.size_m = {0.2, 0.4, 0.4};
-  box.position_m = {0.5, 0, 0};  // its -x face at x = 0.4
-  box.viewpoint = 1;
-  config.render.proxies = {box};
+  const Config config = thrown_at_box_config(1);
   const auto x_after = [&](std::optional<int> viewpoint) {
     ScenePhysics physics(config, load_object_meshes(config));
     for (int64_t t = kT0; t <= kT0 + 400'000'000; t += kFrameNs) {
