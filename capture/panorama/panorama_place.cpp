@@ -28,7 +28,6 @@ PanoramaPlace::PanoramaPlace(const PanoramaViewpoint& viewpoint, bool carries_li
       light_ = std::make_unique<PanoramaLight>(panorama_->width(), panorama_->height(), R_world_pano);
       light_sh_ = light_->project(*panorama_, kVideoLightTaps);
     }
-    leave();
     return;
   }
   panorama_ = std::make_unique<EquirectImage>(EquirectImage::load(viewpoint.file, viewpoint.hdr_scale));

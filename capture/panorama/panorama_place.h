@@ -17,8 +17,8 @@ namespace arpipe {
 
 class PanoramaPlace {
  public:
-  // Loads the still, or opens the video and decodes its first frame (then closes it again until
-  // arrive()). carries_light: the panorama's SH too (a still's from every texel, an HDR still's
+  // Loads the still, or opens the video and decodes its first frame (the view is here until
+  // leave()). carries_light: the panorama's SH too (a still's from every texel, an HDR still's
   // unclipped; a video's from each frame shown). Throws AssetError naming the file.
   PanoramaPlace(const PanoramaViewpoint& viewpoint, bool carries_light);
   ~PanoramaPlace();
@@ -37,6 +37,7 @@ class PanoramaPlace {
   // The shown video frame's index (presentation order from 0); none for a still.
   std::optional<int64_t> frame_index() const;
   const std::optional<ShRgb9>& light_sh() const { return light_sh_; }
+  const PanoramaViewpoint& viewpoint() const { return viewpoint_; }
   // Video frames skipped so far, over every visit: undecodable, or of another size than the stream's.
   uint64_t skipped_video_frames() const;
   std::string describe() const;

@@ -23,10 +23,6 @@ SE3 panorama_view_pose(const PanoramaViewpoint& viewpoint, const Mat3& R_pano_ca
   return SE3(R_cam_world, -1.0 * mat_mul(R_cam_world, viewpoint.position_m));
 }
 
-SE3 panorama_view_pose(const PanoramaConfig& config, const Mat3& R_pano_cam) {
-  return panorama_view_pose(config.viewpoint(0), R_pano_cam);
-}
-
 Mat3 panorama_view_rotation_at(const PanoramaConfig& config, double t_s) {
   return panorama_view_rotation(config.view.yaw_rad + config.view.yaw_rad_per_s * t_s, config.view.pitch_rad);
 }
@@ -79,8 +75,11 @@ Mat3 PanoramaSource::Impl::rotation_at(double t_s, double since_arrival_s) const
 PanoramaSource::PanoramaSource(const SourceConfig& config, bool carries_light) : impl_(std::make_unique<Impl>()) {
   impl_->config = config;
   const PanoramaConfig& panorama = config.panorama;
-  for (size_t k = 0; k < panorama.viewpoint_count(); ++k) impl_->places.emplace_back(panorama.viewpoint(k), carries_light);
-  impl_->places.front().arrive();
+  // Each place opens its video to check it; only the first, in view, keeps its decoder.
+  for (size_t k = 0; k < panorama.viewpoint_count(); ++k) {
+    impl_->places.emplace_back(panorama.viewpoint(k), carries_light);
+    if (k > 0) impl_->places.back().leave();
+  }
   if (!panorama.view.track.empty()) impl_->track = HeadPoseTrack::load(panorama.view.track);
   impl_->view = std::make_unique<PanoramaView>(view_camera(panorama.view));
   impl_->interval_ns = std::llround(1e9 / panorama.view.fps);
@@ -135,7 +134,7 @@ SourceStatus PanoramaSource::next(Frame& frame) {
     frame.meta.raw_timestamp_ns = start_ns;
     frame.meta.frame_duration_ns = s.interval_ns;
     frame.meta.timestamp_offset_ns = s.config.timestamp_offset_ns;
-    frame.meta.known_T_cam_world = panorama_view_pose(panorama.viewpoint(s.here), R_pano_cam);
+    frame.meta.known_T_cam_world = panorama_view_pose(place.viewpoint(), R_pano_cam);
     frame.meta.source_frame_index = place.frame_index();
     frame.meta.viewpoint = int(s.here);
     frame.meta.environment_sh = place.light_sh();

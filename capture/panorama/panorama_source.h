@@ -39,10 +39,8 @@ class PanoramaSource : public FrameSource {
 };
 
 // The view camera's pose turned by R_pano_cam (the view's axes in the panorama's frame): its centre
-// at the viewpoint's position_m, in its panorama placed by its yaw about world z. The config's own
-// form is viewpoint 0's.
+// at the viewpoint's position_m, in its panorama placed by its yaw about world z.
 SE3 panorama_view_pose(const PanoramaViewpoint& viewpoint, const Mat3& R_pano_cam);
-SE3 panorama_view_pose(const PanoramaConfig& config, const Mat3& R_pano_cam);
 // The sweep's turn t_s after arriving at a viewpoint (the view's yaw plus yaw_rad_per_s * t_s, and
 // its pitch), without a track.
 Mat3 panorama_view_rotation_at(const PanoramaConfig& config, double t_s);

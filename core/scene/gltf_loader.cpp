@@ -115,6 +115,9 @@ bool all_finite(const glm::dmat3& m) {
   return true;
 }
 
+// glTF's y-up axes to arpipe's z-up object frame: +y (up) becomes +z, +z (the model's front) -y.
+glm::dvec3 to_object_frame(const glm::dvec3& v) { return glm::dvec3(v.x, -v.z, v.y); }
+
 class GltfMeshCollector {
  public:
   // read_meshes false: only the lights are collected (load_gltf_lights).
@@ -195,7 +198,6 @@ class GltfMeshCollector {
     if (index < 0 || static_cast<size_t>(index) >= model_.lights.size())
       fail(fmt::format("node {} names light {}, which does not exist", node_index, index));
     const tinygltf::Light& light = model_.lights[static_cast<size_t>(index)];
-    const auto to_object_frame = [](const glm::dvec3& v) { return glm::dvec3(v.x, -v.z, v.y); };
     const glm::dvec3 position = to_object_frame(glm::dvec3(transform * glm::dvec4(0, 0, 0, 1)));
     glm::dvec3 direction = to_object_frame(glm::dmat3(transform) * glm::dvec3(0, 0, -1));
     const double length = glm::length(direction);
@@ -426,7 +428,6 @@ class GltfMeshCollector {
     }
 
     // glTF is y-up with the model's front towards +z; the object frame is z-up (x stays x).
-    auto to_object_frame = [](const glm::dvec3& v) { return glm::dvec3(v.x, -v.z, v.y); };
     auto place = [&](const glm::dvec3& position, size_t vertex) {
       const glm::dvec3 placed = to_object_frame(glm::dvec3(transform * glm::dvec4(position, 1.0)));
       for (int axis = 0; axis < 3; ++axis)

@@ -62,7 +62,7 @@ TEST(PanoramaReplay, TheHybridExampleRunsFromTheSimulatedStill) {
     EXPECT_EQ(frame["skipped"]["track"], "pose given by the source") << line;
     EXPECT_EQ(frame["blur"]["method"], "off") << line;
     // The pose is the sweep's at index / fps.
-    const SE3 expected = panorama_view_pose(config.source.panorama, panorama_view_rotation_at(config.source.panorama, lines / config.source.panorama.view.fps));
+    const SE3 expected = panorama_view_pose(config.source.panorama.viewpoint(0), panorama_view_rotation_at(config.source.panorama, lines / config.source.panorama.view.fps));
     const SE3 reported = SE3::from_rt({frame["T_cam_world"]["r"][0], frame["T_cam_world"]["r"][1], frame["T_cam_world"]["r"][2]},
                                       {frame["T_cam_world"]["t"][0], frame["T_cam_world"]["t"][1], frame["T_cam_world"]["t"][2]});
     const SE3 difference = expected.inverse() * reported;

@@ -132,7 +132,7 @@ TEST(HeadPoseTrack, DrivesThePanoramaSourcesViewAndPose) {
     // The track's yaw plus the view's 10 degrees, at the track's pitch; the track's slerp at pitch 0
     // is the yaw's straight line, and between (1 s, yaw 90) and (2 s, pitch 60) a turn about x.
     const double yaw = (t <= 1 ? 90 * t : 90) + 10, pitch = t <= 1 ? 0 : 60 * (t - 1);
-    const SE3 expected = panorama_view_pose(config.panorama, panorama_view_rotation(yaw * kDeg, pitch * kDeg));
+    const SE3 expected = panorama_view_pose(config.panorama.viewpoint(0), panorama_view_rotation(yaw * kDeg, pitch * kDeg));
     const SE3 got = *frame.meta.known_T_cam_world;
     for (size_t r = 0; r < 3; ++r) {
       EXPECT_NEAR(got.translation()[r], expected.translation()[r], 1e-12) << "frame " << k;
