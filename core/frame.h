@@ -7,6 +7,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/geometry/ods_projection.h"
 #include "core/geometry/se3.h"
 #include "core/pixel_format.h"
 #include "core/sh/sh_basis.h"
@@ -47,6 +48,10 @@ struct FrameMetadata {
   // The place the source shows, when it has several (a panorama's viewpoint: 0 is source.panorama's
   // own); proxies of other viewpoints are not drawn.
   std::optional<int> viewpoint;
+  // Which eye of a stereo panorama the frame shows (source.panorama.layout "equirect-tb" or "-lr":
+  // each time step gives the left eye's frame, then the right's, with the same times); the renderer
+  // then draws through that eye's omnidirectional-stereo geometry (core/geometry/ods_projection.h).
+  Eye eye = Eye::Mono;
   // The whole light around the camera, when the source holds it (a panorama, which is its own
   // environment): radiance SH in the world frame, scene-linear (light.source = "panorama").
   std::optional<ShRgb9> environment_sh;

@@ -77,7 +77,9 @@ double max_corner_motion_px(const CameraModel& camera, const std::vector<const U
 
 bool LayerReuse::can_reuse(const Inputs& now) const {
   if (!have_last_ || now.shadow_map_redrawn) return false;
-  if (now.camera_model != last_.camera_model || now.objects != last_.objects || now.rect != last_.rect) return false;
+  if (now.camera_model != last_.camera_model || now.objects != last_.objects || now.rect != last_.rect ||
+      now.eye != last_.eye)
+    return false;
   if (now.exposure_poses.size() != last_.exposure_poses.size()) return false;
   for (size_t k = 0; k < now.exposure_poses.size(); ++k)
     if (max_corner_motion_px(*now.camera_model, now.objects, last_.exposure_poses[k], now.exposure_poses[k]) >

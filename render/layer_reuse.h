@@ -47,6 +47,7 @@ class LayerReuse {
     Lighting lighting;
     bool shadow_map_redrawn = false;  // the shadow map changed since the last layer
     PixelRect rect;
+    Eye eye = Eye::Mono;  // a stereo panorama's eyes see from different places
   };
 
   // Whether the last layer can be shown again for these inputs. The first frame after forget()

@@ -96,6 +96,7 @@ void RenderStage::configure_loaded(const Config& config, const std::shared_ptr<c
   settings.max_predicted_uncertainty_deg = config.render.max_predicted_uncertainty_deg;
   settings.reuse_layer = config.render.reuse_layer;
   settings.full_canvas = config.render.full_canvas;
+  settings.ods = config.source.panorama.ods_rig();
   settings.occluder_lod_px = config.render.occluder_lod_px;
   settings.default_exposure_ns = config.motion.default_exposure_ns;
   settings.blur = config.render.blur;
@@ -271,12 +272,20 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
   }
   std::vector<SE3> exposure_poses;
   for (const Instant& instant : instants) exposure_poses.push_back(instant.T_cam_world);
+  // A stereo panorama's eye draws each point moved by less than its eye's offset (ipd / 2), in
+  // any direction: boxes grown by that hold everything drawn.
+  const Eye eye = ctx.camera.meta.eye;
+  const double eye_offset_m = eye == Eye::Mono ? 0.0 : 0.5 * settings_.ods.ipd_m;
+  const auto drawn_box = [eye_offset_m](const Bounds& box) {
+    const Vec3 grow{eye_offset_m, eye_offset_m, eye_offset_m};
+    return Bounds{box.min - grow, box.max + grow};
+  };
   const auto rect_of = [&](const UploadedObject& object, PixelRect& into) {
     bool in_view = false;
     for (const Instant& instant : instants) {
       const SE3 T_world_object = object.pose_at ? object.pose_at(instant.t_ns) : object.T_world_object;
-      if (std::optional<PixelRect> r =
-              projected_box_rect(image_camera, instant.T_cam_world * T_world_object, object.bounds, kRectMarginPx)) {
+      if (std::optional<PixelRect> r = projected_box_rect(image_camera, instant.T_cam_world * T_world_object,
+                                                          drawn_box(object.bounds), kRectMarginPx)) {
         into = into.united(*r);
         in_view = true;
       }
@@ -316,6 +325,12 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
   request.motion = &motion;
   request.T_cam_world = ctx.pose.T_cam_world;
   request.lens = lens_uniforms(canvas_camera);
+  if (eye != Eye::Mono) {
+    request.lens.eye = eye;
+    request.lens.ods = settings_.ods;
+    // The panorama's axis is the world's up through the view camera's centre (panorama_source.h).
+    request.lens.ods_up_cam = mat_mul(ctx.pose.T_cam_world.rotation(), Vec3{0, 0, 1});
+  }
   request.canvas_camera = &canvas_camera;
   request.rows = {camera.fy(), camera.cy(), camera.height()};
   double angular_diameter_rad = 0;
@@ -331,7 +346,9 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
                                        instants.back().T_cam_world};
       PixelRect shadows;
       for (const SE3& T_cam_world : seen_from) {
-        const std::optional<PixelRect> r = shadow_volume_rect(image_camera, T_cam_world, request.lighting);
+        // (Not bounded through an eye's offsets: then the receivers whole.)
+        const std::optional<PixelRect> r =
+            eye == Eye::Mono ? shadow_volume_rect(image_camera, T_cam_world, request.lighting) : std::nullopt;
         // Unbounded (a grazing light): every receiving proxy in view, whole.
         shadows = shadows.united(r ? *r : PixelRect::full(camera.width(), camera.height()));
       }
@@ -340,7 +357,7 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
     const UploadedObject& catcher = *request.objects.back();
     for (const SE3& T_cam_world : exposure_poses)
       if (std::optional<PixelRect> r =
-              projected_box_rect(image_camera, T_cam_world * catcher.T_world_object, catcher.bounds, kRectMarginPx))
+              projected_box_rect(image_camera, T_cam_world * catcher.T_world_object, drawn_box(catcher.bounds), kRectMarginPx))
         rect = rect.united(*r);
   }
   if (settings_.full_canvas) rect = PixelRect::full(camera.width(), camera.height());
@@ -357,7 +374,7 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
   request.rolling_shutter = settings_.rolling_shutter;
   request.occluder_lod_px = settings_.occluder_lod_px;
 
-  LayerReuse::Inputs inputs{ctx.camera_model, exposure_poses, request.objects, request.lighting, shadow_redrawn, rect};
+  LayerReuse::Inputs inputs{ctx.camera_model, exposure_poses, request.objects, request.lighting, shadow_redrawn, rect, eye};
   if (settings_.reuse_layer && reuse_.can_reuse(inputs)) {
     ctx.virtual_layer = reuse_.layer();
     ctx.virtual_layer_drawn = true;

@@ -67,6 +67,7 @@ class RenderStage final : public Stage {
     double max_predicted_uncertainty_deg = 5.0;
     bool reuse_layer = true;
     bool full_canvas = false;
+    OdsRig ods;  // a stereo panorama source's (source.panorama), for its eyes' frames
     double occluder_lod_px = 0.1;
     int64_t default_exposure_ns = 0;  // motion.default_exposure_ms: for objects that move themselves
     BlurConfig blur;

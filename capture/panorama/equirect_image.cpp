@@ -54,20 +54,67 @@ void EquirectImage::build_levels(int count) {
   }
 }
 
+std::string EquirectImage::shape_problem(PanoramaLayout layout, int width, int height) {
+  switch (layout) {
+    case PanoramaLayout::Equirect: return shape_problem(width, height);
+    case PanoramaLayout::EquirectTopBottom:
+      if (width <= 0 || height <= 0 || height % 2 != 0 || width != height)
+        return fmt::format("{} x {} is not 1:1 with an even height, as a top/bottom stereo pair of 2:1 panoramas is", width, height);
+      return shape_problem(width, height / 2);
+    case PanoramaLayout::EquirectLeftRight:
+      if (width <= 0 || height <= 0 || width % 2 != 0 || width != 4 * height)
+        return fmt::format("{} x {} is not 4:1, as a left/right stereo pair of 2:1 panoramas is", width, height);
+      return shape_problem(width / 2, height);
+  }
+  return "an unknown layout";
+}
+
+std::vector<EquirectImage> EquirectImage::split(std::vector<uint8_t> rgb, int width, int height, PanoramaLayout layout,
+                                                const std::string& name) {
+  if (const std::string why = shape_problem(layout, width, height); !why.empty())
+    throw std::invalid_argument(fmt::format("panorama \"{}\": {}", name, why));
+  if (rgb.size() != size_t(width) * size_t(height) * 3)
+    throw std::invalid_argument(fmt::format("panorama \"{}\": {} bytes for {} x {} RGB", name, rgb.size(), width, height));
+  std::vector<EquirectImage> eyes;
+  if (layout == PanoramaLayout::Equirect) {
+    eyes.emplace_back(std::move(rgb), width, height, name);
+    return eyes;
+  }
+  const bool top_bottom = layout == PanoramaLayout::EquirectTopBottom;
+  const int eye_width = top_bottom ? width : width / 2, eye_height = top_bottom ? height / 2 : height;
+  const size_t eye_row = size_t(eye_width) * 3, row = size_t(width) * 3;
+  for (int eye = 0; eye < 2; ++eye) {
+    std::vector<uint8_t> pixels(eye_row * size_t(eye_height));
+    for (int y = 0; y < eye_height; ++y) {
+      const size_t from = top_bottom ? size_t(eye * eye_height + y) * row : size_t(y) * row + size_t(eye) * eye_row;
+      std::copy_n(rgb.data() + from, eye_row, pixels.data() + size_t(y) * eye_row);
+    }
+    eyes.emplace_back(std::move(pixels), eye_width, eye_height, fmt::format("{} ({} eye)", name, eye == 0 ? "left" : "right"));
+  }
+  return eyes;
+}
+
 EquirectImage EquirectImage::load(const std::filesystem::path& file, double hdr_scale) {
+  return std::move(load_eyes(file, hdr_scale, PanoramaLayout::Equirect).front());
+}
+
+std::vector<EquirectImage> EquirectImage::load_eyes(const std::filesystem::path& file, double hdr_scale,
+                                                    PanoramaLayout layout) {
   const std::string what = "panorama";
   if (panorama_file_kind(file) == PanoramaFileKind::Hdr) {
     const HdrImage hdr = read_hdr_image(file);
-    if (const std::string why = shape_problem(hdr.width, hdr.height); !why.empty())
+    if (const std::string why = shape_problem(layout, hdr.width, hdr.height); !why.empty())
       throw AssetError(fmt::format("{} \"{}\": {}", what, file.string(), why));
     std::vector<uint8_t> rgb(hdr.rgb.size());
     for (size_t i = 0; i < rgb.size(); ++i)
       rgb[i] = static_cast<uint8_t>(std::lround(255 * srgb_encode(std::clamp(double(hdr.rgb[i]) * hdr_scale, 0.0, 1.0))));
-    return EquirectImage(std::move(rgb), hdr.width, hdr.height, file.string());
+    return split(std::move(rgb), hdr.width, hdr.height, layout, file.string());
   }
-  const ImageFileLimits limits{kMaxWidth, int64_t{kMaxWidth} * (kMaxWidth / 2), uint64_t{1} << 30};
+  // A stereo pair holds two panoramas of the largest size.
+  const int64_t eyes = is_stereo(layout) ? 2 : 1;
+  const ImageFileLimits limits{eyes * kMaxWidth, eyes * kMaxWidth * (kMaxWidth / 2), uint64_t(eyes) << 30};
   const cv::Mat bgr = read_image_file(file, what, limits);
-  if (const std::string why = shape_problem(bgr.cols, bgr.rows); !why.empty())
+  if (const std::string why = shape_problem(layout, bgr.cols, bgr.rows); !why.empty())
     throw AssetError(fmt::format("{} \"{}\": {}", what, file.string(), why));
   std::vector<uint8_t> rgb(size_t(bgr.cols) * size_t(bgr.rows) * 3);
   for (int y = 0; y < bgr.rows; ++y) {
@@ -79,7 +126,7 @@ EquirectImage EquirectImage::load(const std::filesystem::path& file, double hdr_
       out[3 * x + 2] = in[3 * x];
     }
   }
-  return EquirectImage(std::move(rgb), bgr.cols, bgr.rows, file.string());
+  return split(std::move(rgb), bgr.cols, bgr.rows, layout, file.string());
 }
 
 const uint8_t* EquirectImage::texel(int level, int x, int y) const {

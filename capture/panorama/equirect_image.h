@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "core/config/panorama_config.h"
+
 namespace arpipe {
 
 class EquirectImage {
@@ -30,6 +32,15 @@ class EquirectImage {
   // PNG or JPEG (sRGB as stored), Radiance .hdr or OpenEXR (linear radiance times hdr_scale,
   // clipped to [0, 1] and sRGB-encoded). Throws AssetError naming the file and what is wrong.
   static EquirectImage load(const std::filesystem::path& file, double hdr_scale);
+  // The same for a layout: one image (mono), or the left eye's then the right eye's of a stereo
+  // pair (each 2:1: the whole file 1:1 for top/bottom, 4:1 for left/right).
+  static std::vector<EquirectImage> load_eyes(const std::filesystem::path& file, double hdr_scale, PanoramaLayout layout);
+  // Splits a whole image of the layout into its eyes (mono: itself). Throws std::invalid_argument
+  // naming `name` for a shape the layout cannot hold (stereo_shape_problem()).
+  static std::vector<EquirectImage> split(std::vector<uint8_t> rgb, int width, int height, PanoramaLayout layout,
+                                          const std::string& name);
+  // What keeps a whole width x height image from holding this layout's eyes, or "" for none.
+  static std::string shape_problem(PanoramaLayout layout, int width, int height);
 
   // The levels the pyramid can have (each the 2 x 2 mean of the one above, while both sides stay
   // even and the height at least kMaxSmallestLevelHeight), and those built so far (level 0 at

@@ -16,27 +16,41 @@ namespace {
 // A video frame's light: each block's mean from 4 x 4 of its texels (a still's from every texel).
 constexpr int kVideoLightTaps = 4;
 
+// A stereo pair's left eye (the whole image for a mono layout), whose shape the loader checked.
+HdrImage left_eye(HdrImage whole, PanoramaLayout layout) {
+  if (layout == PanoramaLayout::Equirect) return whole;
+  HdrImage eye;
+  eye.width = layout == PanoramaLayout::EquirectLeftRight ? whole.width / 2 : whole.width;
+  eye.height = layout == PanoramaLayout::EquirectTopBottom ? whole.height / 2 : whole.height;
+  eye.rgb.resize(size_t(eye.width) * size_t(eye.height) * 3);
+  for (int y = 0; y < eye.height; ++y)
+    std::copy_n(whole.rgb.data() + size_t(y) * size_t(whole.width) * 3, size_t(eye.width) * 3,
+                eye.rgb.data() + size_t(y) * size_t(eye.width) * 3);
+  return eye;
+}
+
 }  // namespace
 
-PanoramaPlace::PanoramaPlace(const PanoramaViewpoint& viewpoint, bool carries_light)
-    : viewpoint_(viewpoint), is_video_(panorama_file_kind(viewpoint.file) == PanoramaFileKind::Video) {
+PanoramaPlace::PanoramaPlace(const PanoramaViewpoint& viewpoint, PanoramaLayout layout, bool carries_light)
+    : viewpoint_(viewpoint), layout_(layout), is_video_(panorama_file_kind(viewpoint.file) == PanoramaFileKind::Video) {
   const Mat3 R_world_pano = default_world_from_probe(viewpoint.yaw_rad);
   if (is_video_) {
     arrive();  // checks that a frame decodes
     video_description_ = video_->describe();
     if (carries_light) {
-      light_ = std::make_unique<PanoramaLight>(panorama_->width(), panorama_->height(), R_world_pano);
-      light_sh_ = light_->project(*panorama_, kVideoLightTaps);
+      light_ = std::make_unique<PanoramaLight>(eyes_.front().width(), eyes_.front().height(), R_world_pano);
+      light_sh_ = light_->project(eyes_.front(), kVideoLightTaps);
     }
     return;
   }
-  panorama_ = std::make_unique<EquirectImage>(EquirectImage::load(viewpoint.file, viewpoint.hdr_scale));
+  eyes_ = EquirectImage::load_eyes(viewpoint.file, viewpoint.hdr_scale, layout);
   if (carries_light) {
     // Every texel, once; an HDR file's unclipped radiance rather than the displayed picture's.
-    const PanoramaLight light(panorama_->width(), panorama_->height(), R_world_pano);
+    const EquirectImage& left = eyes_.front();
+    const PanoramaLight light(left.width(), left.height(), R_world_pano);
     light_sh_ = panorama_file_kind(viewpoint.file) == PanoramaFileKind::Hdr
-                    ? light.project(read_hdr_image(viewpoint.file), viewpoint.hdr_scale)
-                    : light.project(*panorama_);
+                    ? light.project(left_eye(read_hdr_image(viewpoint.file), layout), viewpoint.hdr_scale)
+                    : light.project(left);
   }
 }
 
@@ -45,14 +59,19 @@ PanoramaPlace::PanoramaPlace(PanoramaPlace&&) noexcept = default;
 
 void PanoramaPlace::arrive() {
   if (!is_video_) return;
-  video_ = std::make_unique<PanoramaVideo>(viewpoint_.file);
+  video_ = std::make_unique<PanoramaVideo>(viewpoint_.file, layout_);
   video_frame_ns_ = std::max<int64_t>(1, (1'000'000'000 * video_->rate_den() + video_->rate_num() / 2) / video_->rate_num());
   loop_offset_ns_ = 0;
   if (!video_->next(shown_)) throw AssetError(fmt::format("panorama video \"{}\": no frame decodes", viewpoint_.file.string()));
   has_upcoming_ = video_->next(upcoming_);
-  panorama_ = std::make_unique<EquirectImage>(std::move(shown_.rgb), shown_.width, shown_.height, viewpoint_.file.string());
-  shown_.rgb.clear();
-  if (light_) light_sh_ = light_->project(*panorama_, kVideoLightTaps);
+  show(shown_);
+}
+
+void PanoramaPlace::show(PanoramaVideoFrame& frame) {
+  eyes_ = EquirectImage::split(std::move(frame.rgb), frame.width, frame.height, layout_, viewpoint_.file.string());
+  // EquirectImage took the pixels: keep the size for the next swap.
+  frame.rgb.clear();
+  if (light_) light_sh_ = light_->project(eyes_.front(), kVideoLightTaps);
 }
 
 void PanoramaPlace::leave() {
@@ -63,8 +82,9 @@ void PanoramaPlace::leave() {
 
 uint64_t PanoramaPlace::skipped_video_frames() const { return skipped_before_ + (video_ ? video_->decode_errors() : 0); }
 
-EquirectImage& PanoramaPlace::show_at(int64_t t_ns) {
-  if (!is_video_) return *panorama_;
+EquirectImage& PanoramaPlace::show_at(int64_t t_ns, Eye eye) {
+  const size_t which = eye == Eye::Right && eyes_.size() > 1 ? 1 : 0;
+  if (!is_video_) return eyes_[which];
   if (!video_) arrive();
   const auto fetch = [&] { has_upcoming_ = video_->next(upcoming_); };
   bool changed = false;
@@ -83,13 +103,8 @@ EquirectImage& PanoramaPlace::show_at(int64_t t_ns) {
     fetch();
     if (!has_upcoming_) throw std::runtime_error("no frame after seeking to the start");
   }
-  if (changed) {
-    panorama_ = std::make_unique<EquirectImage>(std::move(shown_.rgb), shown_.width, shown_.height, viewpoint_.file.string());
-    if (light_) light_sh_ = light_->project(*panorama_, kVideoLightTaps);
-  }
-  // EquirectImage took the pixels: keep the size for the next swap.
-  shown_.rgb.clear();
-  return *panorama_;
+  if (changed) show(shown_);
+  return eyes_[which];
 }
 
 std::optional<int64_t> PanoramaPlace::frame_index() const {
@@ -99,7 +114,9 @@ std::optional<int64_t> PanoramaPlace::frame_index() const {
 
 std::string PanoramaPlace::describe() const {
   return fmt::format("{} ({})", viewpoint_.file.string(),
-                     is_video_ ? video_description_ : fmt::format("{} x {}", panorama_->width(), panorama_->height()));
+                     is_video_ ? video_description_
+                               : fmt::format("{} x {}{}", eyes_.front().width(), eyes_.front().height(),
+                                             eyes_.size() > 1 ? " a stereo eye" : ""));
 }
 
 }  // namespace arpipe

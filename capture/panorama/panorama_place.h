@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "capture/panorama/equirect_image.h"
 #include "capture/panorama/panorama_light.h"
@@ -20,7 +21,8 @@ class PanoramaPlace {
   // Loads the still, or opens the video and decodes its first frame (the view is here until
   // leave()). carries_light: the panorama's SH too (a still's from every texel, an HDR still's
   // unclipped; a video's from each frame shown). Throws AssetError naming the file.
-  PanoramaPlace(const PanoramaViewpoint& viewpoint, bool carries_light);
+  // layout: how its file holds the sphere (a stereo pair: both eyes; the light is the left eye's).
+  PanoramaPlace(const PanoramaViewpoint& viewpoint, PanoramaLayout layout, bool carries_light);
   ~PanoramaPlace();
   PanoramaPlace(PanoramaPlace&&) noexcept;
 
@@ -30,9 +32,9 @@ class PanoramaPlace {
   void leave();
 
   // The panorama on screen t_ns after arriving (a video frame is on screen from its presentation
-  // time to the next one's, the last for one frame time, then the video loops). Throws on a video
-  // that cannot be read back from its start.
-  EquirectImage& show_at(int64_t t_ns);
+  // time to the next one's, the last for one frame time, then the video loops), as the eye sees it
+  // (a mono layout's for any eye). Throws on a video that cannot be read back from its start.
+  EquirectImage& show_at(int64_t t_ns, Eye eye = Eye::Mono);
 
   // The shown video frame's index (presentation order from 0); none for a still.
   std::optional<int64_t> frame_index() const;
@@ -43,9 +45,13 @@ class PanoramaPlace {
   std::string describe() const;
 
  private:
+  // The shown frame's eyes (one for a mono layout).
+  void show(PanoramaVideoFrame& frame);
+
   PanoramaViewpoint viewpoint_;
+  PanoramaLayout layout_ = PanoramaLayout::Equirect;
   bool is_video_ = false;
-  std::unique_ptr<EquirectImage> panorama_;  // the still, or the video frame shown
+  std::vector<EquirectImage> eyes_;          // the still, or the video frame shown: mono, or left and right
   std::unique_ptr<PanoramaVideo> video_;     // open while the view is here
   std::string video_description_;
   PanoramaVideoFrame shown_, upcoming_;

@@ -77,7 +77,7 @@ PanoramaSource::PanoramaSource(const SourceConfig& config, bool carries_light) :
   const PanoramaConfig& panorama = config.panorama;
   // Each place opens its video to check it; only the first, in view, keeps its decoder.
   for (size_t k = 0; k < panorama.viewpoint_count(); ++k) {
-    impl_->places.emplace_back(panorama.viewpoint(k), carries_light);
+    impl_->places.emplace_back(panorama.viewpoint(k), panorama.layout, carries_light);
     if (k > 0) impl_->places.back().leave();
   }
   if (!panorama.view.track.empty()) impl_->track = HeadPoseTrack::load(panorama.view.track);
@@ -108,13 +108,16 @@ std::string PanoramaSource::health() const {
 SourceStatus PanoramaSource::next(Frame& frame) {
   Impl& s = *impl_;
   const PanoramaConfig& panorama = s.config.panorama;
-  if (panorama.view.frames > 0 && s.next_index >= uint64_t(panorama.view.frames)) return SourceStatus::EndOfStream;
-  const uint64_t index = s.next_index;
+  // A stereo layout gives each time step twice: its left eye's frame, then its right eye's.
+  const uint64_t eyes = is_stereo(panorama.layout) ? 2 : 1;
+  if (panorama.view.frames > 0 && s.next_index >= uint64_t(panorama.view.frames) * eyes) return SourceStatus::EndOfStream;
+  const uint64_t index = s.next_index, step = index / eyes;
+  const Eye eye = eyes == 1 ? Eye::Mono : index % 2 == 0 ? Eye::Left : Eye::Right;
   int64_t start_ns = 0;
-  if (__builtin_mul_overflow(int64_t(index), s.interval_ns, &start_ns)) return SourceStatus::EndOfStream;
+  if (__builtin_mul_overflow(int64_t(step), s.interval_ns, &start_ns)) return SourceStatus::EndOfStream;
   try {
     if (s.config.pacing == ReplayPacing::Timestamps && !s.clock.wait(start_ns)) return SourceStatus::Retry;
-    const double t_s = double(index) / panorama.view.fps;
+    const double t_s = double(step) / panorama.view.fps;
     // Teleport: the next viewpoint after dwell_s (its video from the start, its sweep again).
     const PanoramaStop stop = panorama_stop_at(panorama, start_ns);
     if (stop.viewpoint != s.here) {
@@ -123,7 +126,7 @@ SourceStatus PanoramaSource::next(Frame& frame) {
       s.places[s.here].arrive();
     }
     PanoramaPlace& place = s.places[s.here];
-    EquirectImage& image = place.show_at(start_ns - stop.arrived_ns);
+    EquirectImage& image = place.show_at(start_ns - stop.arrived_ns, eye);
     const CameraModel& camera = *s.view->camera();
     frame = Frame::allocate(PixelFormat::RGB24, camera.width(), camera.height());
     const Mat3 R_pano_cam = s.rotation_at(t_s, 1e-9 * double(start_ns - stop.arrived_ns));
@@ -137,6 +140,7 @@ SourceStatus PanoramaSource::next(Frame& frame) {
     frame.meta.known_T_cam_world = panorama_view_pose(place.viewpoint(), R_pano_cam);
     frame.meta.source_frame_index = place.frame_index();
     frame.meta.viewpoint = int(s.here);
+    frame.meta.eye = eye;
     frame.meta.environment_sh = place.light_sh();
     uint64_t skipped = 0;
     for (const PanoramaPlace& p : s.places) skipped += p.skipped_video_frames();

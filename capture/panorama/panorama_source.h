@@ -26,7 +26,9 @@ class PanoramaSource : public FrameSource {
   // Frame k (RGB24) shows the view at time k / fps: exposure_start_ns = k / fps in ns, exposure 0
   // (a still has no motion blur), sequence k, the viewpoint shown (FrameMetadata::viewpoint; with
   // several, each for view.dwell_s in turn). Paced at fps with source.pacing = "timestamps".
-  // Ends after view.frames frames (never with 0).
+  // Ends after view.frames frames (never with 0). A stereo layout gives two frames a time step, the
+  // left eye's (sequence 2k) then the right eye's (2k + 1), with the same times and pose
+  // (FrameMetadata::eye); view.frames counts time steps.
   SourceStatus next(Frame& frame) override;
   void interrupt() override;
   // "video frames skipped N (undecodable or of another size), frames failed M" once either is not

@@ -12,7 +12,9 @@ extern "C" {
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <optional>
 #include <string>
+#include <utility>
 
 #include "capture/panorama/equirect_image.h"
 #include "core/log.h"
@@ -65,7 +67,7 @@ struct PanoramaVideo::Impl {
   // sv3d and st3d; Matroska's Projection and StereoMode), before its shape is checked, so that a
   // cubemap, a cropped or a stereo 360 video is refused for what it is: only the whole mono
   // equirectangular layout is built.
-  void check_spherical_metadata(const AVStream* stream) const {
+  void check_spherical_metadata(const AVStream* stream, PanoramaLayout layout) const {
     size_t size = 0;
     if (const uint8_t* data = av_stream_get_side_data(stream, AV_PKT_DATA_SPHERICAL, &size);
         data && size >= sizeof(AVSphericalMapping)) {
@@ -86,9 +88,22 @@ struct PanoramaVideo::Impl {
     if (const uint8_t* data = av_stream_get_side_data(stream, AV_PKT_DATA_STEREO3D, &size);
         data && size >= sizeof(AVStereo3D)) {
       const auto* stereo = reinterpret_cast<const AVStereo3D*>(data);
-      if (stereo->type != AV_STEREO3D_2D)
-        fail(fmt::format("its metadata says it is stereo ({}); stereo layouts are not built yet, only mono",
+      const auto [said, name] = [&]() -> std::pair<std::optional<PanoramaLayout>, std::string_view> {
+        switch (stereo->type) {
+          case AV_STEREO3D_2D: return {PanoramaLayout::Equirect, "equirect"};
+          case AV_STEREO3D_TOPBOTTOM: return {PanoramaLayout::EquirectTopBottom, "equirect-tb"};
+          case AV_STEREO3D_SIDEBYSIDE: return {PanoramaLayout::EquirectLeftRight, "equirect-lr"};
+          default: return {std::nullopt, ""};
+        }
+      }();
+      if (!said)
+        fail(fmt::format("its metadata says it is stereo as {}; only top/bottom and side-by-side pairs are supported",
                          av_stereo3d_type_name(stereo->type)));
+      if ((stereo->flags & AV_STEREO3D_FLAG_INVERT) != 0)
+        fail("its metadata says its right eye comes first; only the left eye first (on top, or on the left) is supported");
+      if (*said != layout)
+        fail(fmt::format("its metadata says the layout is \"{}\" but source.panorama.layout is \"{}\"", name,
+                         choice_name(kPanoramaLayoutNames, layout)));
     }
   }
 
@@ -115,7 +130,7 @@ struct PanoramaVideo::Impl {
   }
 };
 
-PanoramaVideo::PanoramaVideo(const std::filesystem::path& file) : impl_(std::make_unique<Impl>()) {
+PanoramaVideo::PanoramaVideo(const std::filesystem::path& file, PanoramaLayout layout) : impl_(std::make_unique<Impl>()) {
   Impl& s = *impl_;
   s.file = file;
   std::error_code ec;
@@ -137,10 +152,10 @@ PanoramaVideo::PanoramaVideo(const std::filesystem::path& file) : impl_(std::mak
   s.stream = av_find_best_stream(s.format, AVMEDIA_TYPE_VIDEO, -1, -1, &decoder, 0);
   if (s.stream < 0 || !decoder) s.fail("no video stream that H.264, HEVC, VP8, VP9 or AV1 decoding reads");
   AVStream* stream = s.format->streams[s.stream];
-  s.check_spherical_metadata(stream);
+  s.check_spherical_metadata(stream, layout);
   const AVCodecParameters* parameters = stream->codecpar;
   const int width = parameters->width, height = parameters->height;
-  if (const std::string why = EquirectImage::shape_problem(width, height); !why.empty())
+  if (const std::string why = EquirectImage::shape_problem(layout, width, height); !why.empty())
     s.fail(fmt::format("not a panorama: {}", why));
   s.width = width;
   s.height = height;

@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "core/config/panorama_config.h"
+
 namespace arpipe {
 
 struct PanoramaVideoFrame {
@@ -28,7 +30,9 @@ class PanoramaVideo {
  public:
   // Opens the file and its best video stream. Throws AssetError naming the file for anything it
   // cannot open or decode, a codec or container outside the list above, or a shape that is not a panorama.
-  explicit PanoramaVideo(const std::filesystem::path& file);
+  // layout: how each frame holds the sphere (a stereo pair: both eyes); the file's stereo metadata,
+  // where it has some, must say the same.
+  explicit PanoramaVideo(const std::filesystem::path& file, PanoramaLayout layout = PanoramaLayout::Equirect);
   ~PanoramaVideo();
   PanoramaVideo(const PanoramaVideo&) = delete;
   PanoramaVideo& operator=(const PanoramaVideo&) = delete;

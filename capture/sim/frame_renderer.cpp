@@ -26,13 +26,15 @@ FrameRenderer::FrameRenderer(const CameraRayGrid& rays, int width, int height, i
 
 void FrameRenderer::render(const SceneShader& shader, const ShutterPoseTable& poses, const FrameMetadata& meta,
                            double trajectory_time_s, uint64_t frame_index, RadianceImage& out,
-                           std::vector<float>* coverage) const {
+                           std::vector<float>* coverage, Eye eye, const OdsRig& rig) const {
   out.width = width_;
   out.height = height_;
   out.rgb.assign(size_t(width_) * height_ * 3, 0.0f);
   if (coverage != nullptr) coverage->assign(size_t(width_) * height_, 0.0f);
   const double exposure_s = meta.exposure_ns * 1e-9;
   const int spp = samples_per_pixel_, n = samples_per_axis_;
+  const uint64_t first_pixel = eye == Eye::Right ? uint64_t(width_) * uint64_t(height_) : 0;
+  const Vec3 up_cam{0, -1, 0};  // the camera's rows run down its y axis
 
   std::atomic<int> next_row{0};
   auto worker = [&] {
@@ -41,7 +43,7 @@ void FrameRenderer::render(const SceneShader& shader, const ShutterPoseTable& po
       const double row_start_s = trajectory_time_s + row_exposure_start_s(meta, y, height_);
       for (int x = 0; x < width_; ++x) {
         const uint64_t pixel = uint64_t(y) * uint64_t(width_) + uint64_t(x);
-        SampleRng rng(seed_, sample_stream(frame_index, pixel, SampleStream::Shading));
+        SampleRng rng(seed_, sample_stream(frame_index, first_pixel + pixel, SampleStream::Shading));
         // Time strata in a random order, so that position and time strata are not correlated.
         for (int i = 0; i < spp; ++i) time_stratum[size_t(i)] = i;
         for (int i = spp - 1; i > 0; --i) std::swap(time_stratum[size_t(i)], time_stratum[rng.next_u32() % uint32_t(i + 1)]);
@@ -58,8 +60,14 @@ void FrameRenderer::render(const SceneShader& shader, const ShutterPoseTable& po
           const Vec3 dir{R[0][0] * d[0] + R[0][1] * d[1] + R[0][2] * d[2],
                          R[1][0] * d[0] + R[1][1] * d[1] + R[1][2] * d[2],
                          R[2][0] * d[0] + R[2][1] * d[1] + R[2][2] * d[2]};
+          Vec3 origin{pose.centre[0], pose.centre[1], pose.centre[2]};
+          if (eye != Eye::Mono) {
+            const Vec3 o = ods_eye_origin(rig, eye, up_cam, {d[0], d[1], d[2]});
+            origin = origin + Vec3{R[0][0] * o[0] + R[0][1] * o[1] + R[0][2] * o[2], R[1][0] * o[0] + R[1][1] * o[1] + R[1][2] * o[2],
+                                   R[2][0] * o[0] + R[2][1] * o[1] + R[2][2] * o[2]};
+          }
           bool virtual_hit = false;
-          const Rgb radiance = shader.radiance({pose.centre[0], pose.centre[1], pose.centre[2]}, dir, rng, virtual_hit);
+          const Rgb radiance = shader.radiance(origin, dir, rng, virtual_hit);
           covered += virtual_hit ? 1 : 0;
           for (int c = 0; c < 3; ++c) sum[c] += radiance[size_t(c)];
         }

@@ -33,9 +33,12 @@ class FrameRenderer {
   // at meta.exposure_start_ns. coverage, when given, receives per pixel (row-major) the fraction
   // of the pixel's samples whose first hit is a virtual object (the same samples as `out`; a
   // sample outside what the lens sees counts as not covered).
+  // eye: an omnidirectional-stereo pair's eye (Eye::Mono: every ray from the camera's centre):
+  // each ray leaves ods_eye_origin(rig, eye, the camera's up, its direction), and the right eye's
+  // pixels draw their own random numbers (as the pixels of a frame below the left eye's).
   void render(const SceneShader& shader, const ShutterPoseTable& poses, const FrameMetadata& meta,
               double trajectory_time_s, uint64_t frame_index, RadianceImage& out,
-              std::vector<float>* coverage = nullptr) const;
+              std::vector<float>* coverage = nullptr, Eye eye = Eye::Mono, const OdsRig& rig = {}) const;
 
  private:
   const CameraRayGrid& rays_;

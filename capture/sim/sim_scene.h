@@ -166,6 +166,16 @@ struct SimAutoExposure {
   double max_gain = 8.0;
 };
 
+// An omnidirectional-stereo pair ([camera.stereo], a LENSMODEL_LONLAT camera's): each pixel's ray
+// leaves its eye on a circle about the camera's vertical axis (core/geometry/ods_projection.h),
+// and each frame holds the left eye's image above the right's (top_bottom) or left of it. The
+// camera model is one eye's.
+struct SimStereo {
+  bool enabled = false;
+  bool top_bottom = true;
+  OdsRig rig;
+};
+
 struct SimCamera {
   CameraModel model = CameraModel::pinhole(500, 500, 319.5, 239.5, 640, 480);
   PixelFormat pixel_format = PixelFormat::YUYV;
@@ -182,6 +192,11 @@ struct SimCamera {
   int64_t first_exposure_start_ns = 1'000'000'000;
   SimAutoExposure auto_exposure;
   SimSensor sensor;
+  SimStereo stereo;
+
+  // The frame's size: one eye's (the model's), or the stereo pair's.
+  int frame_width() const { return stereo.enabled && !stereo.top_bottom ? 2 * model.width() : model.width(); }
+  int frame_height() const { return stereo.enabled && stereo.top_bottom ? 2 * model.height() : model.height(); }
 };
 
 // sqrt(samples_per_pixel) when it is a perfect square of at least 1, else 0.

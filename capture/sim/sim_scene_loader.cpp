@@ -187,14 +187,29 @@ SimCamera read_camera(const TomlSection& s) {
 
   camera.pixel_format = s.parsed<PixelFormat>("pixel_format", camera.pixel_format, pixel_format_from_name,
                                               "one of \"GREY\", \"RGB24\", \"YUYV\", \"NV12\"");
+  if (const auto stereo = s.section("stereo")) {
+    SimStereo& out = camera.stereo;
+    out.enabled = true;
+    if (camera.model.lensmodel() != "LENSMODEL_LONLAT")
+      stereo->fail_with("layout", fmt::format("expected a LENSMODEL_LONLAT camera for an omnidirectional-stereo pair, found {}",
+                                              camera.model.lensmodel()));
+    const std::string layout = stereo->string("layout", "tb");
+    if (layout != "tb" && layout != "lr") stereo->fail("layout", "\"tb\" (left eye on top) or \"lr\" (left eye on the left)", fmt::format("\"{}\"", layout));
+    out.top_bottom = layout == "tb";
+    out.rig.ipd_m = stereo->number("ipd_m", out.rig.ipd_m, NumberRange::open_closed(0, 1));
+    out.rig.pole_merge_from_rad = degrees(*stereo, "pole_merge_from_deg", out.rig.pole_merge_from_rad, NumberRange::closed(0, 90));
+    out.rig.pole_merge_to_rad = degrees(*stereo, "pole_merge_to_deg", out.rig.pole_merge_to_rad, NumberRange::closed(0, 90));
+    if (out.rig.pole_merge_to_rad < out.rig.pole_merge_from_rad)
+      stereo->fail("pole_merge_to_deg", "at least pole_merge_from_deg", fmt::format("{:g}", out.rig.pole_merge_to_rad / kRadiansPerDegree));
+  }
   const std::string_view format = pixel_format_name(camera.pixel_format);
-  if (const auto problem = check_image_size(camera.pixel_format, camera.model.width(), camera.model.height())) {
+  if (const auto problem = check_image_size(camera.pixel_format, camera.frame_width(), camera.frame_height())) {
     const std::string_view k = s.has("pixel_format") ? "pixel_format" : s.has("model") ? "model" : "width";
     s.fail_with(k, fmt::format("expected an image size that {} can hold, found {}x{}: {}", format, camera.model.width(),
                                camera.model.height(), *problem));
   }
-  if (camera.model.width() > kMaxFrameSide || camera.model.height() > kMaxFrameSide ||
-      int64_t{camera.model.width()} * camera.model.height() > kMaxFramePixels) {
+  if (camera.frame_width() > kMaxFrameSide || camera.frame_height() > kMaxFrameSide ||
+      int64_t{camera.frame_width()} * camera.frame_height() > kMaxFramePixels) {
     const std::string_view k = s.has("model") ? "model" : camera.model.width() > kMaxFrameSide || !s.has("height") ? "width" : "height";
     s.fail_with(k, fmt::format("expected a simulated frame of at most {} pixels a side and {} pixels in all (rendering "
                                "holds about 80 bytes a pixel), found {}x{}",

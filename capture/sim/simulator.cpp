@@ -135,6 +135,39 @@ Frame to_frame(const std::vector<uint8_t>& rgb, int width, int height, PixelForm
   return frame;
 }
 
+// Rows of `eye` (channels values a pixel) placed in the pair's image: below or right of the first.
+void place_eye(const std::vector<float>& eye, int width, int height, int channels, bool top_bottom, int which,
+               std::vector<float>& pair) {
+  const size_t row = size_t(width) * size_t(channels);
+  const size_t pair_row = top_bottom ? row : 2 * row;
+  pair.resize(pair_row * size_t(top_bottom ? 2 * height : height));
+  for (int y = 0; y < height; ++y) {
+    const size_t to = top_bottom ? size_t(which * height + y) * pair_row : size_t(y) * pair_row + size_t(which) * row;
+    std::copy_n(eye.data() + size_t(y) * row, row, pair.data() + to);
+  }
+}
+
+// One frame's radiance (and coverage) as the camera sees it: a mono image, or the stereo pair's
+// two eyes in their places.
+void render_frame(const FrameRenderer& renderer, const SimCamera& camera, const SceneShader& shader,
+                  const ShutterPoseTable& poses, const FrameMetadata& meta, double start_s, uint64_t index,
+                  RadianceImage& out, std::vector<float>* coverage) {
+  if (!camera.stereo.enabled) {
+    renderer.render(shader, poses, meta, start_s, index, out, coverage);
+    return;
+  }
+  RadianceImage eye;
+  std::vector<float> eye_coverage;
+  for (int which = 0; which < 2; ++which) {
+    renderer.render(shader, poses, meta, start_s, index, eye, coverage ? &eye_coverage : nullptr,
+                    which == 0 ? Eye::Left : Eye::Right, camera.stereo.rig);
+    place_eye(eye.rgb, eye.width, eye.height, 3, camera.stereo.top_bottom, which, out.rgb);
+    if (coverage) place_eye(eye_coverage, eye.width, eye.height, 1, camera.stereo.top_bottom, which, *coverage);
+  }
+  out.width = camera.frame_width();
+  out.height = camera.frame_height();
+}
+
 }  // namespace
 
 SimulateSummary simulate(const SimScene& scene, const SimulateOptions& options) {
@@ -143,7 +176,7 @@ SimulateSummary simulate(const SimScene& scene, const SimulateOptions& options) 
   const int frames = options.frames > 0 ? options.frames : scene.render.frames;
   if (frames <= 0) throw std::invalid_argument(fmt::format("simulate: frames must be positive, got {}", frames));
   const uint64_t seed = options.seed.value_or(scene.render.seed);
-  const int width = camera.model.width(), height = camera.model.height();
+  const int width = camera.frame_width(), height = camera.frame_height();
   if (width > kMaxFrameSide || height > kMaxFrameSide || int64_t{width} * height > kMaxFramePixels)
     throw std::invalid_argument(fmt::format("simulate: a {}x{} frame exceeds the limit of {} pixels a side and {} "
                                             "pixels in all (rendering holds about 80 bytes a pixel)",
@@ -155,7 +188,12 @@ SimulateSummary simulate(const SimScene& scene, const SimulateOptions& options) 
   const CameraTrajectory trajectory(scene.trajectory, camera, duration_s, seed);
   const SensorModel sensor(camera.sensor);
   const CameraRayGrid rays(camera.model);
-  const FrameRenderer renderer(rays, width, height, scene.render.samples_per_pixel, seed, options.threads);
+  // A stereo pair's recording carries the left eye's lens over the whole pair's frame: exact for
+  // the left eye's half, which starts at the frame's top left corner.
+  const CameraModel recorded_model =
+      camera.stereo.enabled ? CameraModel(camera.model.lensmodel(), camera.model.intrinsics(), width, height) : camera.model;
+  const FrameRenderer renderer(rays, camera.model.width(), camera.model.height(), scene.render.samples_per_pixel, seed,
+                               options.threads);
   const SceneShader camera_world(scene, false);
   std::optional<SceneShader> composite_world;
   if (scene.has_virtual_objects()) composite_world.emplace(scene, true);
@@ -165,17 +203,17 @@ SimulateSummary simulate(const SimScene& scene, const SimulateOptions& options) 
                                  : options.source_description;
   RecordingWriter writer(options.out_dir, RecordingInfo{kRecordingFormatVersion, camera.pixel_format, width, height, 0,
                                                         source, ""},
-                         camera.model);
+                         recorded_model);
   std::optional<RecordingWriter> composite_writer, coverage_writer;
   if (composite_world) {
     composite_writer.emplace(options.out_dir / kGroundTruthCompositeDir,
                              RecordingInfo{kRecordingFormatVersion, PixelFormat::RGB24, width, height, 0,
                                            source + ": ground-truth composite", ""},
-                             camera.model);
+                             recorded_model);
     coverage_writer.emplace(options.out_dir / kGroundTruthCoverageDir,
                             RecordingInfo{kRecordingFormatVersion, PixelFormat::GREY, width, height, 0,
                                           source + ": ground-truth coverage of the virtual objects", ""},
-                            camera.model);
+                            recorded_model);
   }
   if (!scene.source_file.empty() && fs::is_regular_file(scene.source_file)) {
     std::error_code ignored;  // a copy for reproducibility; the recording does not need it
@@ -195,7 +233,7 @@ SimulateSummary simulate(const SimScene& scene, const SimulateOptions& options) 
     const double start_s = trajectory_time_s(camera, meta.exposure_start_ns);
 
     const ShutterPoseTable poses(trajectory, start_s, start_s + (meta.exposure_ns + meta.readout_ns) * 1e-9);
-    renderer.render(camera_world, poses, meta, start_s, index, radiance);
+    render_frame(renderer, camera, camera_world, poses, meta, start_s, index, radiance, nullptr);
     GroundTruthFrame truth = ground_truth(scene, trajectory, meta, lights);
     if (scene.render.write_linear) {
       truth.linear_image = fmt::format("linear_{:06d}.pfm", k);
@@ -204,7 +242,7 @@ SimulateSummary simulate(const SimScene& scene, const SimulateOptions& options) 
     writer.append(to_frame(expose(radiance, sensor, exposure, seed, index), width, height, camera.pixel_format, meta),
                   truth);
     if (composite_world) {
-      renderer.render(*composite_world, poses, meta, start_s, index, composite_radiance, &coverage);
+      render_frame(renderer, camera, *composite_world, poses, meta, start_s, index, composite_radiance, &coverage);
       composite_writer->append(
           to_frame(expose(composite_radiance, sensor, exposure, seed, index), width, height, PixelFormat::RGB24, meta),
           truth);

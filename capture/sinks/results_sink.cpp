@@ -39,6 +39,7 @@ nlohmann::json ResultsSink::to_json(const FrameContext& ctx) {
   j["dropped_before"] = ctx.dropped_before;
   if (ctx.camera.meta.source_frame_index) j["source_frame_index"] = *ctx.camera.meta.source_frame_index;
   if (ctx.camera.meta.viewpoint) j["viewpoint"] = *ctx.camera.meta.viewpoint;
+  if (ctx.camera.meta.eye != Eye::Mono) j["eye"] = std::string(eye_name(ctx.camera.meta.eye));
   j["track_state"] = std::string(track_state_name(ctx.pose.state));
   if (ctx.pose.state == TrackState::Predicted) {
     j["frames_since_measured"] = ctx.pose.frames_since_measured;

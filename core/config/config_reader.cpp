@@ -53,6 +53,9 @@ void check_cross_keys(const TomlSection& t, PanoramaConfig& s) {
                                           PanoramaConfig::kMaxViewpoints));
   if (!s.viewpoints.empty() && s.view.dwell_s <= 0)
     t.fail_with("viewpoints", "expected source.panorama.view.dwell_s > 0 with more than one viewpoint (the time at each)");
+  if (s.pole_merge_to_rad < s.pole_merge_from_rad)
+    t.fail("pole_merge_to_deg", fmt::format("at least pole_merge_from_deg ({:g})", s.pole_merge_from_rad * 180 / std::numbers::pi),
+           fmt::format("{:g}", s.pole_merge_to_rad * 180 / std::numbers::pi));
 }
 
 void check_cross_keys(const TomlSection& t, PanoramaViewConfig& s) {

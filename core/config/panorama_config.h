@@ -11,14 +11,19 @@
 
 #include "core/config/choice_names.h"
 #include "core/config/config_rules.h"
+#include "core/geometry/ods_projection.h"
 #include "core/geometry/vec.h"
 
 namespace arpipe {
 
-// How the image holds the sphere (source.panorama.layout). Only the mono equirectangular layout
-// is built; the stereo layouts (top/bottom, left/right) are not yet.
-enum class PanoramaLayout { Equirect };
-inline constexpr ChoiceName<PanoramaLayout> kPanoramaLayoutNames[] = {{"equirect", PanoramaLayout::Equirect}};
+// How the image holds the sphere (source.panorama.layout): one equirectangular image (2:1), or
+// an omnidirectional-stereo pair (core/geometry/ods_projection.h), each eye 2:1, the left eye's on
+// top (1:1 in all) or on the left (4:1).
+enum class PanoramaLayout { Equirect, EquirectTopBottom, EquirectLeftRight };
+inline constexpr ChoiceName<PanoramaLayout> kPanoramaLayoutNames[] = {{"equirect", PanoramaLayout::Equirect},
+                                                                      {"equirect-tb", PanoramaLayout::EquirectTopBottom},
+                                                                      {"equirect-lr", PanoramaLayout::EquirectLeftRight}};
+inline bool is_stereo(PanoramaLayout layout) { return layout != PanoramaLayout::Equirect; }
 
 // The camera that looks at the panorama, and where it looks over time.
 struct PanoramaViewConfig {
@@ -88,6 +93,11 @@ struct PanoramaConfig {
   Vec3 position_m{0, 0, 0};            // where in the world it was taken (the view camera's centre)
   double yaw_rad = 0;                  // its turn about world z (as light.environment.yaw_deg)
   double hdr_scale = 1;                // .hdr / .exr: the file's radiance to display values (1.0 = white)
+  // A stereo layout's capture: the distance between its eyes, and the elevations over which it
+  // brought them together towards the poles (core/geometry/ods_projection.h).
+  double ipd_m = 0.064;
+  double pole_merge_from_rad = 60 * std::numbers::pi / 180;
+  double pole_merge_to_rad = 75 * std::numbers::pi / 180;
   PanoramaViewConfig view;
   // Viewpoints 1, 2, ... (this table's own file, position and yaw are viewpoint 0).
   std::vector<PanoramaViewpoint> viewpoints;
@@ -98,6 +108,7 @@ struct PanoramaConfig {
     return k == 0 ? PanoramaViewpoint{file, position_m, yaw_rad, hdr_scale} : viewpoints.at(k - 1);
   }
   size_t viewpoint_count() const { return 1 + viewpoints.size(); }
+  OdsRig ods_rig() const { return {ipd_m, pole_merge_from_rad, pole_merge_to_rad}; }
 
   bool operator==(const PanoramaConfig&) const = default;
 };
@@ -105,10 +116,17 @@ struct PanoramaConfig {
 template <class V>
 void visit(V& v, PanoramaConfig& s) {
   v.key("file", s.file, "a still (PNG, JPEG, .hdr, .exr) or a looped video (.mp4, .mov, .mkv, .webm: H.264, HEVC, VP8, VP9, AV1)");
-  v.key("layout", s.layout, kPanoramaLayoutNames, "how the image holds the sphere (equirect: 2:1, mono)");
+  v.key("layout", s.layout, kPanoramaLayoutNames,
+        "how the image holds the sphere: equirect (2:1, mono), equirect-tb or equirect-lr (omnidirectional stereo, "
+        "the left eye on top or on the left)");
   v.key("position_m", s.position_m, "where in the world it was taken (the view's centre)");
   v.key("yaw_deg", s.yaw_rad, Degrees{NumberRange::closed(-360, 360)}, "its turn about world z (0: the centre looks along +y)");
   v.key("hdr_scale", s.hdr_scale, NumberRange::open_closed(0, 1e12), "HDR files: radiance to display value (1 = white)");
+  v.key("ipd_m", s.ipd_m, NumberRange::open_closed(0, 1).in("m"), "stereo layouts: the capture's distance between the eyes");
+  v.key("pole_merge_from_deg", s.pole_merge_from_rad, Degrees{NumberRange::closed(0, 90)},
+        "stereo layouts: the elevation up to which the capture kept the eyes ipd_m apart");
+  v.key("pole_merge_to_deg", s.pole_merge_to_rad, Degrees{NumberRange::closed(0, 90)},
+        "stereo layouts: the elevation from which it had brought them together (a raised-cosine fall between)");
   v.section("view", s.view, "the camera that looks at the panorama");
   v.sections("viewpoints", s.viewpoints, "more places, each its own panorama: [[source.panorama.viewpoints]], visited in turn");
 }

@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include "core/geometry/ods_projection.h"
 #include "render/gl/render_errors.h"
 
 namespace arpipe {
@@ -35,7 +36,10 @@ vec2 lens_distort(vec2 p) {
 // next grid point and flip a sample at an edge; from a grid point its rounding comes back to it.
 vec2 on_subpixel_grid(vec2 pixel) { return floor(pixel * 256.0 + 0.5) / 256.0; }
 
-vec4 camera_to_clip(vec3 p) {
+vec4 camera_to_clip(vec3 p_view) {
+  // A stereo panorama's eye (core/geometry/ods_projection.h): the point where that eye's panorama
+  // holds it; p_view itself for a mono view.
+  vec3 p = ods_eye_point(p_view);
   vec2 clip_xy;
   if (p.z > kNear) {
     vec2 pixel = u_lens_distorted ? lens_distort(p.xy / p.z) : p.xy / p.z;
@@ -53,7 +57,7 @@ vec4 camera_to_clip(vec3 p) {
 )glsl";
 
 std::string make_source() {
-  std::string source(kLensProjectionGlsl);
+  std::string source = std::string(ods_projection_glsl()) + std::string(kLensProjectionGlsl);
   auto replace = [&](std::string_view token, double value) {
     source.replace(source.find(token), token.size(), fmt::format("{:.6f}", value));
   };
@@ -106,6 +110,10 @@ void set_lens_uniforms(const GlProgram& program, const LensUniforms& lens) {
                      f(lens.distortion[6]), f(lens.distortion[7]));
   glUniform1i(program.uniform("u_lens_distorted"), lens.distorted ? 1 : 0);
   glUniform2f(program.uniform("u_image_size"), f(lens.width), f(lens.height));
+  const double half_ipd = lens.eye == Eye::Left ? 0.5 * lens.ods.ipd_m : lens.eye == Eye::Right ? -0.5 * lens.ods.ipd_m : 0.0;
+  glUniform1f(program.uniform("u_ods_eye"), f(half_ipd));
+  glUniform3f(program.uniform("u_ods_up"), f(lens.ods_up_cam[0]), f(lens.ods_up_cam[1]), f(lens.ods_up_cam[2]));
+  glUniform2f(program.uniform("u_ods_merge"), f(lens.ods.pole_merge_from_rad), f(lens.ods.pole_merge_to_rad));
 }
 
 }  // namespace arpipe

@@ -7,6 +7,7 @@
 #include <string_view>
 
 #include "core/geometry/camera_model.h"
+#include "core/geometry/ods_projection.h"
 #include "render/gl/gl_program.h"
 
 namespace arpipe {
@@ -21,6 +22,12 @@ struct LensUniforms {
   bool distorted = false;                // false for LENSMODEL_PINHOLE
   int width = 0;
   int height = 0;
+  // A stereo panorama's eye (core/geometry/ods_projection.h): points are drawn where that eye's
+  // omnidirectional-stereo panorama holds them, the circle's axis being ods_up_cam (unit, camera
+  // frame) through the camera's centre. Eye::Mono: as they are.
+  Eye eye = Eye::Mono;
+  OdsRig ods;
+  Vec3 ods_up_cam{0, -1, 0};
 };
 
 // Whether the vertex shader can project through this mrcal lens model (render.lens = "vertex").
@@ -30,7 +37,8 @@ void check_lens_model_supported(const CameraModel& model);
 // Throws RenderError as above.
 LensUniforms lens_uniforms(const CameraModel& model);
 
-// GLSL ES 3.00 source (no #version line) declaring `vec4 camera_to_clip(vec3 p_cam)`: p_cam in the
+// GLSL ES 3.00 source (no #version line) declaring `vec4 camera_to_clip(vec3 p_cam)` (and the
+// ods_projection_glsl() it calls first, whose uniforms set_lens_uniforms sets too): p_cam in the
 // camera frame (x right, y down, z forward) goes to the clip position whose window coordinates
 // are the model's pixel coordinates plus one half (GL pixel centres lie at +0.5, mrcal's at 0),
 // with image row v on GL row v, so a read-back framebuffer is in image row order.

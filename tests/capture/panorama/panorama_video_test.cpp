@@ -18,6 +18,7 @@ extern "C" {
 #include <fstream>
 #include <optional>
 #include <random>
+#include <tuple>
 
 #include "capture/panorama/panorama_source.h"
 #include "capture/panorama/panorama_video.h"
@@ -176,9 +177,9 @@ TEST(PanoramaVideo, TheSourceShowsEachOutputFrameTheVideoFrameOfItsTime) {
 }
 
 // Opening `file` must fail with an AssetError naming it and saying `expected`.
-void refused(const fs::path& file, const std::string& expected) {
+void refused(const fs::path& file, const std::string& expected, PanoramaLayout layout = PanoramaLayout::Equirect) {
   try {
-    PanoramaVideo video(file);
+    PanoramaVideo video(file, layout);
     ADD_FAILURE() << file << " was accepted";
   } catch (const AssetError& e) {
     EXPECT_NE(std::string(e.what()).find(file.string()), std::string::npos) << e.what();
@@ -263,8 +264,55 @@ TEST(PanoramaVideo, SphericalMetadataThatIsNotMonoEquirectangularIsRefusedForWha
   refused(dir / "cubemap.mp4", "the cubemap projection; only equirectangular");
   remux_with_metadata(plain, dir / "cropped.mp4", AV_SPHERICAL_EQUIRECTANGULAR_TILE, 1u << 30, std::nullopt);
   refused(dir / "cropped.mp4", "crops the sphere");
+  // A layout the config does not say, or a shape that cannot hold it. (Packings other than
+  // top/bottom and side by side are refused too; MP4's st3d box cannot hold them.)
   remux_with_metadata(plain, dir / "stereo.mp4", std::nullopt, 0, AV_STEREO3D_TOPBOTTOM);
-  refused(dir / "stereo.mp4", "stereo (top and bottom)");
+  refused(dir / "stereo.mp4", "its metadata says the layout is \"equirect-tb\" but source.panorama.layout is \"equirect\"");
+  refused(dir / "stereo.mp4", "is not 1:1", PanoramaLayout::EquirectTopBottom);
+  refused(dir / "stereo.mp4", "says the layout is \"equirect-tb\" but source.panorama.layout is \"equirect-lr\"",
+          PanoramaLayout::EquirectLeftRight);
+  refused(dir / "equirect.mp4", "says the layout is \"equirect\" but source.panorama.layout is \"equirect-tb\"",
+          PanoramaLayout::EquirectTopBottom);
+  fs::remove_all(dir);
+}
+
+TEST(PanoramaVideo, AStereoVideoGivesEachTimeStepItsLeftThenItsRightEye) {
+  // Top/bottom: the left eye red (on top), the right blue; and the same side by side.
+  const fs::path dir = test::scratch_dir("panorama-video-stereo");
+  for (const auto& [layout, stack, size] : {std::tuple{PanoramaLayout::EquirectTopBottom, "vstack", "64x64"},
+                                            std::tuple{PanoramaLayout::EquirectLeftRight, "hstack", "128x32"}}) {
+    const fs::path file = dir / fmt::format("{}.mp4", stack);
+    ASSERT_EQ(std::system(fmt::format("ffmpeg -nostdin -v error -y -f lavfi -i 'color=c=red:s=64x32:r=30:d=0.2[a];"
+                                      "color=c=blue:s=64x32:r=30:d=0.2[b];[a][b]{}' -c:v libx264 -pix_fmt yuv444p '{}'",
+                                      stack, file.string())
+                                  .c_str()),
+              0);
+    {
+      const PanoramaVideo video(file, layout);
+      EXPECT_EQ(fmt::format("{}x{}", video.width(), video.height()), size);
+    }
+    SourceConfig config;
+    config.type = SourceType::Panorama;
+    config.pacing = ReplayPacing::Fast;
+    config.panorama.file = file;
+    config.panorama.layout = layout;
+    config.panorama.view.width = 16;
+    config.panorama.view.height = 8;
+    config.panorama.view.fps = 30;
+    config.panorama.view.frames = 3;
+    PanoramaSource source(config);
+    Frame frame;
+    for (int k = 0; k < 6; ++k) {
+      ASSERT_EQ(source.next(frame), SourceStatus::Frame) << k;
+      EXPECT_EQ(frame.meta.sequence, uint64_t(k));
+      EXPECT_EQ(frame.meta.eye, k % 2 == 0 ? Eye::Left : Eye::Right) << k;
+      EXPECT_EQ(frame.meta.exposure_start_ns, (k / 2) * std::llround(1e9 / 30)) << k;
+      const uint8_t* centre = frame.data.data() + 4 * frame.bytes_per_line + 3 * 8;
+      if (k % 2 == 0) EXPECT_TRUE(centre[0] > 200 && centre[2] < 60) << stack << " frame " << k << ": not red";
+      else EXPECT_TRUE(centre[2] > 200 && centre[0] < 60) << stack << " frame " << k << ": not blue";
+    }
+    EXPECT_EQ(source.next(frame), SourceStatus::EndOfStream);
+  }
   fs::remove_all(dir);
 }
 
