@@ -25,6 +25,12 @@ inline constexpr ChoiceName<PanoramaLayout> kPanoramaLayoutNames[] = {{"equirect
                                                                       {"equirect-lr", PanoramaLayout::EquirectLeftRight}};
 inline bool is_stereo(PanoramaLayout layout) { return layout != PanoramaLayout::Equirect; }
 
+// What the sinks get from a stereo layout (source.panorama.view.stereo_output): each eye's picture
+// as its own frame, or the two in one frame, the left eye's on top or on the left.
+enum class StereoOutput { Frames, TopBottom, LeftRight };
+inline constexpr ChoiceName<StereoOutput> kStereoOutputNames[] = {
+    {"frames", StereoOutput::Frames}, {"tb", StereoOutput::TopBottom}, {"lr", StereoOutput::LeftRight}};
+
 // The camera that looks at the panorama, and where it looks over time.
 struct PanoramaViewConfig {
   std::filesystem::path camera_model;  // an mrcal .cameramodel; empty: a pinhole of width, height, hfov
@@ -45,6 +51,7 @@ struct PanoramaViewConfig {
   // last back to the first); the sweep starts again at each. The seed's protocol: 60 (720 degrees
   // at 12 degrees/s).
   double dwell_s = 0;
+  StereoOutput stereo_output = StereoOutput::TopBottom;
 
   bool operator==(const PanoramaViewConfig&) const = default;
 };
@@ -64,6 +71,8 @@ void visit(V& v, PanoramaViewConfig& s) {
   v.key("track", s.track, "a head-pose track file (t_s with yaw_deg, pitch_deg, roll_deg or qw, qx, qy, qz) instead of the sweep");
   v.key("dwell_s", s.dwell_s, NumberRange::closed(0, 1e6).in("s"),
         "with [[source.panorama.viewpoints]]: time at each viewpoint before the next (the seed's protocol: 60)");
+  v.key("stereo_output", s.stereo_output, kStereoOutputNames,
+        "stereo layouts: the sinks get both eyes in one frame, left on top (tb) or left (lr), or each eye's frame (frames)");
 }
 
 // Another place a panorama was taken (seed 003's teleport points), visited after the one before.

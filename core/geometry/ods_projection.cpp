@@ -11,6 +11,7 @@ std::string_view eye_name(Eye eye) {
   switch (eye) {
     case Eye::Left: return "left";
     case Eye::Right: return "right";
+    case Eye::Pair: return "pair";
     case Eye::Mono: break;
   }
   return "mono";

@@ -20,9 +20,10 @@
 
 namespace arpipe {
 
-// Which eye a frame shows (FrameMetadata::eye).
-enum class Eye : uint8_t { Mono, Left, Right };
-std::string_view eye_name(Eye eye);  // "mono", "left", "right"
+// Which eye a frame shows (FrameMetadata::eye); Pair: both, packed into one picture
+// (core/pipeline/stereo_packer.h).
+enum class Eye : uint8_t { Mono, Left, Right, Pair };
+std::string_view eye_name(Eye eye);  // "mono", "left", "right", "pair"
 
 struct OdsRig {
   double ipd_m = 0.064;              // the distance between the eyes

@@ -18,6 +18,10 @@ PipelineRunner::PipelineRunner(std::unique_ptr<FrameSource> source, StageFactory
     : source_(std::move(source)), stage_factory_(std::move(stages)), config_(config),
       max_frames_(config.pipeline.max_frames) {
   unkeyed_sinks_ = std::move(sinks);
+  const PanoramaConfig& panorama = config.source.panorama;
+  if (config.source.type == SourceType::Panorama && is_stereo(panorama.layout) &&
+      panorama.view.stereo_output != StereoOutput::Frames)
+    stereo_packer_.emplace(panorama.view.stereo_output);
 }
 
 PipelineRunner::~PipelineRunner() {
@@ -248,6 +252,14 @@ void PipelineRunner::sink_loop() {
       sink_busy_since_ns_ = 0;
       continue;
     }
+    if (stereo_packer_) {  // a stereo panorama's eyes go on as one frame
+      std::optional<FrameContext> pair = stereo_packer_->add(std::move(item->frame));
+      if (!pair) {
+        sink_busy_since_ns_ = 0;
+        continue;
+      }
+      item->frame = std::move(*pair);
+    }
     const int64_t origin_ns = item->frame.latency_origin_ns();
     auto frame = std::make_shared<const FrameContext>(std::move(item->frame));
     for (auto& worker : sinks_) worker->push(frame);
@@ -258,6 +270,8 @@ void PipelineRunner::sink_loop() {
     metrics_.latency_seconds.add(double(now - origin_ns) * 1e-9);
     metrics_.wall_seconds = double(now - start_ns_) * 1e-9;
   }
+  if (stereo_packer_ && stereo_packer_->unpaired() > 0)
+    log::warn("stereo output: {} eye frames came without their other eye and were not shown", stereo_packer_->unpaired());
   // Every sink takes what is queued for it and flushes.
   for (auto& worker : sinks_) worker->finish();
   finished_ = true;

@@ -21,6 +21,7 @@
 #include "core/pipeline/sink_slot.h"
 #include "core/pipeline/stage.h"
 #include "core/pipeline/stage_reloader.h"
+#include "core/pipeline/stereo_packer.h"
 
 namespace arpipe {
 
@@ -108,6 +109,7 @@ class PipelineRunner {
   std::atomic<int64_t> max_frames_{0};  // config_.pipeline.max_frames, for the capture thread
   std::unique_ptr<BoundedQueue<FrameContext>> to_process_;
   std::unique_ptr<BoundedQueue<ToSink>> to_sink_;
+  std::optional<StereoPacker> stereo_packer_;  // a stereo panorama packed for the sinks (sink thread only)
   std::thread capture_thread_, processing_thread_, sink_thread_;
   std::atomic<bool> stop_requested_{false};
   std::atomic<bool> finished_{false};

@@ -4,6 +4,7 @@
 // line is the configured sweep's, and the proxies report hiding part of the cube; with the still as
 // the light, each frame's ambient light is the still's SH. Bad panorama
 // files stop the daemon at setup with the file named.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -11,6 +12,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <opencv2/imgcodecs.hpp>
 
 #include "capture/panorama/equirect_image.h"
 #include "capture/panorama/panorama_light.h"
@@ -99,6 +101,61 @@ TEST(PanoramaReplay, TheHybridExampleRunsFromTheSimulatedStill) {
       EXPECT_NEAR(light["lights"][0]["direction_world"][k].get<double>(), config.render.light_direction[k], 1e-12);
   }
   EXPECT_EQ(lit_lines, 2);
+  fs::remove_all(out);
+}
+
+TEST(PanoramaReplay, AStereoStillGivesBothEyesPackedOrAsFramesOfTheirOwn) {
+  // A top/bottom pair whose left eye is red and right eye blue, through the hybrid example.
+  const fs::path out = out_dir("panorama-stereo");
+  const fs::path still = out / "pair.png";
+  ASSERT_EQ(std::system(fmt::format("ffmpeg -nostdin -v error -y -f lavfi -i 'color=c=red:s=512x256[a];color=c=blue:s=512x256[b];"
+                                    "[a][b]vstack' -frames:v 1 '{}'", still.string()).c_str()),
+            0);
+  constexpr int kSteps = 3, kWidth = 320, kHeight = 180;
+  const auto run = [&](const std::string& packing, const std::string& name) {
+    const std::vector<std::string> overrides{"source.panorama.file=\"" + still.string() + "\"",
+                                             "source.panorama.layout=\"equirect-tb\"",
+                                             "source.panorama.view.stereo_output=\"" + packing + "\"",
+                                             "source.panorama.view.frames=" + std::to_string(kSteps),
+                                             fmt::format("source.panorama.view.width={}", kWidth),
+                                             fmt::format("source.panorama.view.height={}", kHeight),
+                                             "sinks.png.dir=\"" + (out / name).string() + "\"",
+                                             "sinks.results.path=\"" + (out / (name + ".jsonl")).string() + "\""};
+    std::vector<std::string> args{"--config", kConfig.string()};
+    for (const std::string& o : overrides) args.insert(args.end(), {"--set", o});
+    std::string stderr_text;
+    EXPECT_EQ(test::run_to_exit(test::build_program("arpiped"), args, out / ("logs-" + name), &stderr_text), 0) << stderr_text;
+    std::vector<nlohmann::json> lines;
+    std::ifstream in(out / (name + ".jsonl"));
+    for (std::string line; std::getline(in, line);) lines.push_back(nlohmann::json::parse(line));
+    return lines;
+  };
+  // Packed top/bottom: a frame a time step, twice as high, red above blue.
+  const std::vector<nlohmann::json> packed = run("tb", "tb");
+  ASSERT_EQ(packed.size(), size_t(kSteps));
+  for (size_t k = 0; k < packed.size(); ++k) {
+    EXPECT_EQ(packed[k]["eye"], "pair");
+    EXPECT_TRUE(packed[k]["virtual_layer_drawn"].get<bool>());
+    const cv::Mat png = cv::imread((out / "tb" / fmt::format("frame_{:06d}.png", packed[k]["index"].get<int>())).string());
+    ASSERT_EQ(png.cols, kWidth);
+    ASSERT_EQ(png.rows, 2 * kHeight);
+    const cv::Vec3b top = png.at<cv::Vec3b>(2, 2), bottom = png.at<cv::Vec3b>(kHeight + 2, 2);  // BGR, a corner of sky
+    EXPECT_TRUE(top[2] > 200 && top[0] < 60) << "the left eye's picture is not on top";
+    EXPECT_TRUE(bottom[0] > 200 && bottom[2] < 60) << "the right eye's picture is not below";
+  }
+  // Side by side.
+  const std::vector<nlohmann::json> beside = run("lr", "lr");
+  ASSERT_EQ(beside.size(), size_t(kSteps));
+  const cv::Mat png = cv::imread((out / "lr" / fmt::format("frame_{:06d}.png", beside[0]["index"].get<int>())).string());
+  EXPECT_EQ(png.cols, 2 * kWidth);
+  EXPECT_EQ(png.rows, kHeight);
+  // Each eye its own frame: left then right, the same time.
+  const std::vector<nlohmann::json> frames = run("frames", "frames");
+  ASSERT_EQ(frames.size(), size_t(2 * kSteps));
+  for (size_t k = 0; k < frames.size(); ++k) {
+    EXPECT_EQ(frames[k]["eye"], k % 2 == 0 ? "left" : "right");
+    EXPECT_EQ(frames[k]["exposure_start_ns"], frames[k - k % 2]["exposure_start_ns"]);
+  }
   fs::remove_all(out);
 }
 

@@ -660,5 +660,27 @@ TEST(Config, PanoramaViewpointsNeedADwellAndTheirProxiesAViewpointThatExists) {
                {"source.panorama.viewpoints[0].file", "expected the viewpoint's panorama file"});
 }
 
+TEST(Config, AStereoPanoramaNamesItsLayoutRigAndOutput) {
+  const Config stereo = parse_config(
+      "[source]\ntype = \"panorama\"\n[source.panorama]\nfile = \"p.png\"\nlayout = \"equirect-lr\"\nipd_m = 0.063\n"
+      "pole_merge_from_deg = 50.0\npole_merge_to_deg = 80.0\n[source.panorama.view]\nstereo_output = \"frames\"\n",
+      "test.toml");
+  const PanoramaConfig& p = stereo.source.panorama;
+  EXPECT_EQ(p.layout, PanoramaLayout::EquirectLeftRight);
+  EXPECT_EQ(p.view.stereo_output, StereoOutput::Frames);
+  EXPECT_EQ(p.ods_rig().ipd_m, 0.063);
+  EXPECT_NEAR(p.ods_rig().pole_merge_from_rad, 50 * std::numbers::pi / 180, 1e-15);
+  EXPECT_NEAR(p.ods_rig().pole_merge_to_rad, 80 * std::numbers::pi / 180, 1e-15);
+  // The defaults: the left eye on top, 64 mm apart, merged from 60 to 75 degrees, packed top/bottom.
+  const PanoramaConfig defaults;
+  EXPECT_EQ(defaults.layout, PanoramaLayout::Equirect);
+  EXPECT_EQ(defaults.view.stereo_output, StereoOutput::TopBottom);
+  EXPECT_EQ(defaults.ods_rig(), OdsRig{});
+  expect_error("[source.panorama]\npole_merge_from_deg = 70.0\npole_merge_to_deg = 65.0\n",
+               {"source.panorama.pole_merge_to_deg", "at least pole_merge_from_deg (70)", "65"});
+  expect_error("[source.panorama]\nlayout = \"cubemap\"\n", {"source.panorama.layout", "equirect-tb"});
+  expect_error("[source.panorama]\nipd_m = 0.0\n", {"source.panorama.ipd_m"});
+}
+
 }  // namespace
 }  // namespace arpipe
