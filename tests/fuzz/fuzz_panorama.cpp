@@ -1,9 +1,11 @@
 // libFuzzer target: the panorama source's readers on every input, as a still (PNG/JPEG through
 // capture/image_file, then the 2:1 check and the pyramid) and as a video (FFmpeg's MP4/MOV and
 // Matroska/WebM demuxers and the decoders capture/panorama/panorama_video allows, a few frames and
-// a seek). Anything bad must be an AssetError; a frame that comes out must be a whole panorama.
+// a seek), and both as stereo pairs. Anything bad must be an AssetError; a frame that comes out must
+// be a whole panorama.
 #include <cstddef>
 #include <cstdint>
+#include <vector>
 
 #include "capture/panorama/equirect_image.h"
 #include "capture/panorama/panorama_video.h"
@@ -23,6 +25,17 @@ void load_still(const uint8_t* data, size_t size) {
     image.sample(image.levels() - 1, -1.5f, -0.5f, rgb);  // across the seam and over the pole
   } catch (const arpipe::AssetError&) {
   }
+  // As a stereo pair, each layout: two eyes of one 2:1 size.
+  for (const arpipe::PanoramaLayout layout : {arpipe::PanoramaLayout::EquirectTopBottom, arpipe::PanoramaLayout::EquirectLeftRight}) {
+    try {
+      const std::vector<arpipe::EquirectImage> eyes =
+          arpipe::EquirectImage::load_eyes(arpipe::fuzz::write_temp_file("panorama.png", data, size), 1.0, layout);
+      ARPIPE_FUZZ_CHECK(eyes.size() == 2 && eyes[0].width() == 2 * eyes[0].height() && eyes[1].width() == eyes[0].width() &&
+                            eyes[1].height() == eyes[0].height(),
+                        "two 2:1 eyes of one size");
+    } catch (const arpipe::AssetError&) {
+    }
+  }
 }
 
 void read_video(const uint8_t* data, size_t size) {
@@ -34,6 +47,14 @@ void read_video(const uint8_t* data, size_t size) {
                         "a whole 2:1 frame");
     video.seek(1);
     (void)video.next(frame);
+  } catch (const arpipe::AssetError&) {
+  }
+  try {  // a top/bottom pair: 1:1 frames
+    arpipe::PanoramaVideo video(arpipe::fuzz::write_temp_file("panorama.mp4", data, size), arpipe::PanoramaLayout::EquirectTopBottom);
+    arpipe::PanoramaVideoFrame frame;
+    if (video.next(frame))
+      ARPIPE_FUZZ_CHECK(frame.width == frame.height && frame.rgb.size() == size_t(frame.width) * size_t(frame.height) * 3,
+                        "a whole 1:1 pair");
   } catch (const arpipe::AssetError&) {
   }
 }
