@@ -48,10 +48,10 @@ OcclusionMeter::~OcclusionMeter() = default;
 std::vector<ObjectReport> OcclusionMeter::measure(const CameraModel& camera, const SE3& T_cam_world,
                                                   const std::vector<UploadedObject>& objects,
                                                   const std::vector<UploadedObject>& proxies,
-                                                  const std::optional<int>& viewpoint) const {
+                                                  const std::optional<int>& viewpoint, Eye eye, const OdsRig& rig) const {
   std::vector<ObjectReport> reports;
   const SE3 T_world_cam = T_cam_world.inverse();
-  const Vec3 eye = T_world_cam.translation();
+  const Vec3 origin = T_world_cam.translation();
   const double fx = camera.fx(), fy = camera.fy(), cx = camera.cx(), cy = camera.cy();
   std::vector<std::optional<PlacedScene>> occluders;
   for (size_t p = 0; p < proxies.size() && p < proxy_scenes_.size(); ++p)
@@ -65,10 +65,13 @@ std::vector<ObjectReport> OcclusionMeter::measure(const CameraModel& camera, con
     report.position_m = object.T_world_object.translation();
     report.present = object.present;
     // The box's extent in the pinhole core, clipped to the picture; corners behind the camera
-    // leave the box unmeasured (it is then mostly out of view).
+    // leave the box unmeasured (it is then mostly out of view). An eye of a stereo panorama draws
+    // each point moved by less than ipd / 2: the box grown by that holds it.
     double u0 = std::numeric_limits<double>::infinity(), u1 = -u0, v0 = u0, v1 = -u0;
     bool behind = false;
-    for (const Vec3& corner : box_corners(object.bounds)) {
+    const double grow = eye == Eye::Mono ? 0.0 : 0.5 * rig.ipd_m;
+    const Bounds box{object.bounds.min - Vec3{grow, grow, grow}, object.bounds.max + Vec3{grow, grow, grow}};
+    for (const Vec3& corner : box_corners(box)) {
       const Vec3 p = T_cam_world * (object.T_world_object * corner);
       if (p[2] <= 1e-6) {
         behind = true;
@@ -88,14 +91,15 @@ std::vector<ObjectReport> OcclusionMeter::measure(const CameraModel& camera, con
         for (int gx = 0; gx < kGrid; ++gx) {
           const double u = u0 + (gx + 0.5) * (u1 - u0) / kGrid, v = v0 + (gy + 0.5) * (v1 - v0) / kGrid;
           const Vec3 dir = T_world_cam.rotate(Vec3{(u - cx) / fx, (v - cy) / fy, 1.0});
-          const std::optional<float> t_object = placed.hit_distance(eye, dir);
+          const Vec3 from = origin + ods_eye_origin(rig, eye, Vec3{0, 0, 1}, normalized(dir));
+          const std::optional<float> t_object = placed.hit_distance(from, dir);
           if (!t_object) continue;
           ++met;
           float nearest = *t_object;
           std::optional<size_t> by;
           for (size_t p = 0; p < occluders.size(); ++p) {
             if (!occluders[p]) continue;
-            const std::optional<float> t_proxy = occluders[p]->hit_distance(eye, dir);
+            const std::optional<float> t_proxy = occluders[p]->hit_distance(from, dir);
             if (t_proxy && *t_proxy < nearest) nearest = *t_proxy, by = p;
           }
           if (by) ++hidden_by[*by];

@@ -25,10 +25,12 @@ class OcclusionMeter {
   ~OcclusionMeter();
 
   // One report per object of `objects` (as placed for this frame), seen from T_cam_world, hidden
-  // by the proxies at the frame's viewpoint (proxy_at_viewpoint).
+  // by the proxies at the frame's viewpoint (proxy_at_viewpoint). A stereo panorama's eye: each
+  // ray leaves that eye's place on the circle about world z (core/geometry/ods_projection.h).
   std::vector<ObjectReport> measure(const CameraModel& camera, const SE3& T_cam_world,
                                     const std::vector<UploadedObject>& objects,
-                                    const std::vector<UploadedObject>& proxies, const std::optional<int>& viewpoint = {}) const;
+                                    const std::vector<UploadedObject>& proxies, const std::optional<int>& viewpoint = {},
+                                    Eye eye = Eye::Mono, const OdsRig& rig = {}) const;
 
  private:
   std::vector<std::shared_ptr<const PrtRayScene>> object_scenes_;  // per render.objects entry

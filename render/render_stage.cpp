@@ -251,7 +251,8 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
   }
   if (occlusion_meter_) {
     const auto measure_start = std::chrono::steady_clock::now();
-    ctx.objects = occlusion_meter_->measure(camera, ctx.pose.T_cam_world, objects_, proxies_, ctx.camera.meta.viewpoint);
+    ctx.objects = occlusion_meter_->measure(camera, ctx.pose.T_cam_world, objects_, proxies_, ctx.camera.meta.viewpoint,
+                                            ctx.camera.meta.eye, settings_.ods);
     ctx.record_timing("occlusion", milliseconds_since(measure_start));
   }
 

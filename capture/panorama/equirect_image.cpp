@@ -56,6 +56,7 @@ void EquirectImage::build_levels(int count) {
 
 std::string EquirectImage::shape_problem(PanoramaLayout layout, int width, int height) {
   switch (layout) {
+    case PanoramaLayout::Auto: return shape_problem(layout_of_shape(width, height), width, height);
     case PanoramaLayout::Equirect: return shape_problem(width, height);
     case PanoramaLayout::EquirectTopBottom:
       if (width <= 0 || height <= 0 || height % 2 != 0 || width != height)
@@ -75,6 +76,7 @@ std::vector<EquirectImage> EquirectImage::split(std::vector<uint8_t> rgb, int wi
     throw std::invalid_argument(fmt::format("panorama \"{}\": {}", name, why));
   if (rgb.size() != size_t(width) * size_t(height) * 3)
     throw std::invalid_argument(fmt::format("panorama \"{}\": {} bytes for {} x {} RGB", name, rgb.size(), width, height));
+  if (layout == PanoramaLayout::Auto) layout = layout_of_shape(width, height);
   std::vector<EquirectImage> eyes;
   if (layout == PanoramaLayout::Equirect) {
     eyes.emplace_back(std::move(rgb), width, height, name);
@@ -111,7 +113,7 @@ std::vector<EquirectImage> EquirectImage::load_eyes(const std::filesystem::path&
     return split(std::move(rgb), hdr.width, hdr.height, layout, file.string());
   }
   // A stereo pair holds two panoramas of the largest size.
-  const int64_t eyes = is_stereo(layout) ? 2 : 1;
+  const int64_t eyes = layout == PanoramaLayout::Equirect ? 1 : 2;
   const ImageFileLimits limits{eyes * kMaxWidth, eyes * kMaxWidth * (kMaxWidth / 2), uint64_t(eyes) << 30};
   const cv::Mat bgr = read_image_file(file, what, limits);
   if (const std::string why = shape_problem(layout, bgr.cols, bgr.rows); !why.empty())

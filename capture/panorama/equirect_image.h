@@ -33,7 +33,7 @@ class EquirectImage {
   // clipped to [0, 1] and sRGB-encoded). Throws AssetError naming the file and what is wrong.
   static EquirectImage load(const std::filesystem::path& file, double hdr_scale);
   // The same for a layout: one image (mono), or the left eye's then the right eye's of a stereo
-  // pair (each 2:1: the whole file 1:1 for top/bottom, 4:1 for left/right).
+  // pair (each 2:1: the whole file 1:1 for top/bottom, 4:1 for left/right; Auto: by the shape).
   static std::vector<EquirectImage> load_eyes(const std::filesystem::path& file, double hdr_scale, PanoramaLayout layout);
   // Splits a whole image of the layout into its eyes (mono: itself). Throws std::invalid_argument
   // naming `name` for a shape the layout cannot hold (stereo_shape_problem()).

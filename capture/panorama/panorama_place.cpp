@@ -17,11 +17,12 @@ namespace {
 constexpr int kVideoLightTaps = 4;
 
 // A stereo pair's left eye (the whole image for a mono layout), whose shape the loader checked.
-HdrImage left_eye(HdrImage whole, PanoramaLayout layout) {
-  if (layout == PanoramaLayout::Equirect) return whole;
+HdrImage left_eye(HdrImage whole) {
+  if (whole.width == 2 * whole.height) return whole;  // mono (the loader checked the layout's shape)
   HdrImage eye;
-  eye.width = layout == PanoramaLayout::EquirectLeftRight ? whole.width / 2 : whole.width;
-  eye.height = layout == PanoramaLayout::EquirectTopBottom ? whole.height / 2 : whole.height;
+  const bool left_right = whole.width == 4 * whole.height;
+  eye.width = left_right ? whole.width / 2 : whole.width;
+  eye.height = left_right ? whole.height : whole.height / 2;
   eye.rgb.resize(size_t(eye.width) * size_t(eye.height) * 3);
   for (int y = 0; y < eye.height; ++y)
     std::copy_n(whole.rgb.data() + size_t(y) * size_t(whole.width) * 3, size_t(eye.width) * 3,
@@ -36,6 +37,7 @@ PanoramaPlace::PanoramaPlace(const PanoramaViewpoint& viewpoint, PanoramaLayout 
   const Mat3 R_world_pano = default_world_from_probe(viewpoint.yaw_rad);
   if (is_video_) {
     arrive();  // checks that a frame decodes
+    layout_ = video_->layout();  // Auto resolved: reopened so on each arrival
     video_description_ = video_->describe();
     if (carries_light) {
       light_ = std::make_unique<PanoramaLight>(eyes_.front().width(), eyes_.front().height(), R_world_pano);
@@ -49,7 +51,7 @@ PanoramaPlace::PanoramaPlace(const PanoramaViewpoint& viewpoint, PanoramaLayout 
     const EquirectImage& left = eyes_.front();
     const PanoramaLight light(left.width(), left.height(), R_world_pano);
     light_sh_ = panorama_file_kind(viewpoint.file) == PanoramaFileKind::Hdr
-                    ? light.project(left_eye(read_hdr_image(viewpoint.file), layout), viewpoint.hdr_scale)
+                    ? light.project(left_eye(read_hdr_image(viewpoint.file)), viewpoint.hdr_scale)
                     : light.project(left);
   }
 }

@@ -40,6 +40,8 @@ class PanoramaPlace {
   std::optional<int64_t> frame_index() const;
   const std::optional<ShRgb9>& light_sh() const { return light_sh_; }
   const PanoramaViewpoint& viewpoint() const { return viewpoint_; }
+  // Whether it holds two eyes (its layout, resolved from the file for "auto").
+  bool stereo() const { return eyes_.size() > 1; }
   // Video frames skipped so far, over every visit: undecodable, or of another size than the stream's.
   uint64_t skipped_video_frames() const;
   std::string describe() const;

@@ -14,6 +14,7 @@
 #include "capture/panorama/panorama_view.h"
 #include "core/environment/hdr_environment.h"
 #include "core/log.h"
+#include "core/scene/asset_error.h"
 
 namespace arpipe {
 
@@ -80,6 +81,13 @@ PanoramaSource::PanoramaSource(const SourceConfig& config, bool carries_light) :
     impl_->places.emplace_back(panorama.viewpoint(k), panorama.layout, carries_light);
     if (k > 0) impl_->places.back().leave();
   }
+  // Every viewpoint mono, or every one stereo: the frames of a time step are one or two throughout.
+  for (const PanoramaPlace& place : impl_->places)
+    if (place.stereo() != impl_->places.front().stereo())
+      throw AssetError(fmt::format("panorama \"{}\" is {} but \"{}\" is {}: the viewpoints must all be mono or all stereo",
+                                   place.viewpoint().file.string(), place.stereo() ? "stereo" : "mono",
+                                   impl_->places.front().viewpoint().file.string(),
+                                   impl_->places.front().stereo() ? "stereo" : "mono"));
   if (!panorama.view.track.empty()) impl_->track = HeadPoseTrack::load(panorama.view.track);
   impl_->view = std::make_unique<PanoramaView>(view_camera(panorama.view));
   impl_->interval_ns = std::llround(1e9 / panorama.view.fps);
@@ -109,7 +117,7 @@ SourceStatus PanoramaSource::next(Frame& frame) {
   Impl& s = *impl_;
   const PanoramaConfig& panorama = s.config.panorama;
   // A stereo layout gives each time step twice: its left eye's frame, then its right eye's.
-  const uint64_t eyes = is_stereo(panorama.layout) ? 2 : 1;
+  const uint64_t eyes = s.places.front().stereo() ? 2 : 1;
   if (panorama.view.frames > 0 && s.next_index >= uint64_t(panorama.view.frames) * eyes) return SourceStatus::EndOfStream;
   const uint64_t index = s.next_index, step = index / eyes;
   const Eye eye = eyes == 1 ? Eye::Mono : index % 2 == 0 ? Eye::Left : Eye::Right;

@@ -43,6 +43,7 @@ struct PanoramaVideo::Impl {
   AVFrame* frame = nullptr;
   int stream = -1;
   int width = 0, height = 0;  // the stream's, checked at open: a frame of another size is skipped
+  PanoramaLayout layout = PanoramaLayout::Equirect;
   AVRational time_base{0, 1};
   AVRational rate{0, 1};
   int64_t start_pts = 0;
@@ -67,7 +68,8 @@ struct PanoramaVideo::Impl {
   // sv3d and st3d; Matroska's Projection and StereoMode), before its shape is checked, so that a
   // cubemap, a cropped or a stereo 360 video is refused for what it is: only the whole mono
   // equirectangular layout is built.
-  void check_spherical_metadata(const AVStream* stream, PanoramaLayout layout) const {
+  // Returns the layout the metadata says, when it says one.
+  std::optional<PanoramaLayout> check_spherical_metadata(const AVStream* stream, PanoramaLayout layout) const {
     size_t size = 0;
     if (const uint8_t* data = av_stream_get_side_data(stream, AV_PKT_DATA_SPHERICAL, &size);
         data && size >= sizeof(AVSphericalMapping)) {
@@ -101,10 +103,12 @@ struct PanoramaVideo::Impl {
                          av_stereo3d_type_name(stereo->type)));
       if ((stereo->flags & AV_STEREO3D_FLAG_INVERT) != 0)
         fail("its metadata says its right eye comes first; only the left eye first (on top, or on the left) is supported");
-      if (*said != layout)
+      if (layout != PanoramaLayout::Auto && *said != layout)
         fail(fmt::format("its metadata says the layout is \"{}\" but source.panorama.layout is \"{}\"", name,
                          choice_name(kPanoramaLayoutNames, layout)));
+      return said;
     }
+    return std::nullopt;
   }
 
   int64_t index_of(int64_t pts) const {
@@ -152,9 +156,11 @@ PanoramaVideo::PanoramaVideo(const std::filesystem::path& file, PanoramaLayout l
   s.stream = av_find_best_stream(s.format, AVMEDIA_TYPE_VIDEO, -1, -1, &decoder, 0);
   if (s.stream < 0 || !decoder) s.fail("no video stream that H.264, HEVC, VP8, VP9 or AV1 decoding reads");
   AVStream* stream = s.format->streams[s.stream];
-  s.check_spherical_metadata(stream, layout);
+  const std::optional<PanoramaLayout> said = s.check_spherical_metadata(stream, layout);
   const AVCodecParameters* parameters = stream->codecpar;
   const int width = parameters->width, height = parameters->height;
+  if (layout == PanoramaLayout::Auto) layout = said ? *said : layout_of_shape(width, height);
+  s.layout = layout;
   if (const std::string why = EquirectImage::shape_problem(layout, width, height); !why.empty())
     s.fail(fmt::format("not a panorama: {}", why));
   s.width = width;
@@ -174,6 +180,7 @@ PanoramaVideo::PanoramaVideo(const std::filesystem::path& file, PanoramaLayout l
 
 PanoramaVideo::~PanoramaVideo() = default;
 
+PanoramaLayout PanoramaVideo::layout() const { return impl_->layout; }
 int PanoramaVideo::width() const { return impl_->width; }
 int PanoramaVideo::height() const { return impl_->height; }
 int64_t PanoramaVideo::rate_num() const { return impl_->rate.num; }

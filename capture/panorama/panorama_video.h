@@ -31,12 +31,14 @@ class PanoramaVideo {
   // Opens the file and its best video stream. Throws AssetError naming the file for anything it
   // cannot open or decode, a codec or container outside the list above, or a shape that is not a panorama.
   // layout: how each frame holds the sphere (a stereo pair: both eyes); the file's stereo metadata,
-  // where it has some, must say the same.
-  explicit PanoramaVideo(const std::filesystem::path& file, PanoramaLayout layout = PanoramaLayout::Equirect);
+  // where it has some, must say the same. Auto: what the metadata says, else what the shape holds.
+  explicit PanoramaVideo(const std::filesystem::path& file, PanoramaLayout layout = PanoramaLayout::Auto);
   ~PanoramaVideo();
   PanoramaVideo(const PanoramaVideo&) = delete;
   PanoramaVideo& operator=(const PanoramaVideo&) = delete;
 
+  // The layout its frames hold (never Auto).
+  PanoramaLayout layout() const;
   int width() const;
   int height() const;
   // The nominal frame rate (the stream's average rate, else its base rate) as num / den.

@@ -18,12 +18,22 @@ namespace arpipe {
 
 // How the image holds the sphere (source.panorama.layout): one equirectangular image (2:1), or
 // an omnidirectional-stereo pair (core/geometry/ods_projection.h), each eye 2:1, the left eye's on
-// top (1:1 in all) or on the left (4:1).
-enum class PanoramaLayout { Equirect, EquirectTopBottom, EquirectLeftRight };
-inline constexpr ChoiceName<PanoramaLayout> kPanoramaLayoutNames[] = {{"equirect", PanoramaLayout::Equirect},
+// top (1:1 in all) or on the left (4:1). Auto: what a video's spherical metadata says, else what
+// the shape holds (2:1 mono, 1:1 top/bottom, 4:1 left/right).
+enum class PanoramaLayout { Auto, Equirect, EquirectTopBottom, EquirectLeftRight };
+inline constexpr ChoiceName<PanoramaLayout> kPanoramaLayoutNames[] = {{"auto", PanoramaLayout::Auto},
+                                                                      {"equirect", PanoramaLayout::Equirect},
                                                                       {"equirect-tb", PanoramaLayout::EquirectTopBottom},
                                                                       {"equirect-lr", PanoramaLayout::EquirectLeftRight}};
-inline bool is_stereo(PanoramaLayout layout) { return layout != PanoramaLayout::Equirect; }
+inline bool is_stereo(PanoramaLayout layout) {
+  return layout == PanoramaLayout::EquirectTopBottom || layout == PanoramaLayout::EquirectLeftRight;
+}
+// The layout a width x height image holds by its shape (Equirect for any shape but 1:1 and 4:1).
+inline PanoramaLayout layout_of_shape(int width, int height) {
+  if (width == height) return PanoramaLayout::EquirectTopBottom;
+  if (int64_t{width} == 4 * int64_t{height}) return PanoramaLayout::EquirectLeftRight;
+  return PanoramaLayout::Equirect;
+}
 
 // What the sinks get from a stereo layout (source.panorama.view.stereo_output): each eye's picture
 // as its own frame, or the two in one frame, the left eye's on top or on the left.
@@ -98,7 +108,7 @@ struct PanoramaConfig {
   // A still: PNG, JPEG (8-bit sRGB), Radiance .hdr or OpenEXR .exr; or a video (.mp4, .m4v, .mov,
   // .mkv, .webm: H.264, HEVC, VP8, VP9, AV1), looped.
   std::filesystem::path file;
-  PanoramaLayout layout = PanoramaLayout::Equirect;
+  PanoramaLayout layout = PanoramaLayout::Auto;
   Vec3 position_m{0, 0, 0};            // where in the world it was taken (the view camera's centre)
   double yaw_rad = 0;                  // its turn about world z (as light.environment.yaw_deg)
   double hdr_scale = 1;                // .hdr / .exr: the file's radiance to display values (1.0 = white)
@@ -127,7 +137,7 @@ void visit(V& v, PanoramaConfig& s) {
   v.key("file", s.file, "a still (PNG, JPEG, .hdr, .exr) or a looped video (.mp4, .mov, .mkv, .webm: H.264, HEVC, VP8, VP9, AV1)");
   v.key("layout", s.layout, kPanoramaLayoutNames,
         "how the image holds the sphere: equirect (2:1, mono), equirect-tb or equirect-lr (omnidirectional stereo, "
-        "the left eye on top or on the left)");
+        "the left eye on top or on the left), auto (a video's metadata, else the shape: 2:1, 1:1, 4:1)");
   v.key("position_m", s.position_m, "where in the world it was taken (the view's centre)");
   v.key("yaw_deg", s.yaw_rad, Degrees{NumberRange::closed(-360, 360)}, "its turn about world z (0: the centre looks along +y)");
   v.key("hdr_scale", s.hdr_scale, NumberRange::open_closed(0, 1e12), "HDR files: radiance to display value (1 = white)");

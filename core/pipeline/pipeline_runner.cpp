@@ -19,8 +19,8 @@ PipelineRunner::PipelineRunner(std::unique_ptr<FrameSource> source, StageFactory
       max_frames_(config.pipeline.max_frames) {
   unkeyed_sinks_ = std::move(sinks);
   const PanoramaConfig& panorama = config.source.panorama;
-  if (config.source.type == SourceType::Panorama && is_stereo(panorama.layout) &&
-      panorama.view.stereo_output != StereoOutput::Frames)
+  if (config.source.type == SourceType::Panorama && panorama.layout != PanoramaLayout::Equirect &&
+      panorama.view.stereo_output != StereoOutput::Frames)  // (mono frames pass through it)
     stereo_packer_.emplace(panorama.view.stereo_output);
 }
 

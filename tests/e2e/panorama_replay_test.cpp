@@ -105,7 +105,8 @@ TEST(PanoramaReplay, TheHybridExampleRunsFromTheSimulatedStill) {
 }
 
 TEST(PanoramaReplay, AStereoStillGivesBothEyesPackedOrAsFramesOfTheirOwn) {
-  // A top/bottom pair whose left eye is red and right eye blue, through the hybrid example.
+  // A top/bottom pair whose left eye is red and right eye blue, through the hybrid example (the
+  // layout "auto": told by the 1:1 shape).
   const fs::path out = out_dir("panorama-stereo");
   const fs::path still = out / "pair.png";
   ASSERT_EQ(std::system(fmt::format("ffmpeg -nostdin -v error -y -f lavfi -i 'color=c=red:s=512x256[a];color=c=blue:s=512x256[b];"
@@ -114,7 +115,6 @@ TEST(PanoramaReplay, AStereoStillGivesBothEyesPackedOrAsFramesOfTheirOwn) {
   constexpr int kSteps = 3, kWidth = 320, kHeight = 180;
   const auto run = [&](const std::string& packing, const std::string& name) {
     const std::vector<std::string> overrides{"source.panorama.file=\"" + still.string() + "\"",
-                                             "source.panorama.layout=\"equirect-tb\"",
                                              "source.panorama.view.stereo_output=\"" + packing + "\"",
                                              "source.panorama.view.frames=" + std::to_string(kSteps),
                                              fmt::format("source.panorama.view.width={}", kWidth),

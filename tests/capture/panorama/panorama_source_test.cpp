@@ -82,9 +82,12 @@ TEST(PanoramaSource, GivesTheConfiguredFramesWithTheirPoses) {
 
 TEST(PanoramaSource, RefusesBadFilesNamingThem) {
   const auto dir = test::scratch_dir("panorama-bad");
-  const auto refused = [&](const std::filesystem::path& file, const std::string& expected) {
+  const auto refused = [&](const std::filesystem::path& file, const std::string& expected,
+                           PanoramaLayout layout = PanoramaLayout::Auto) {
     try {
-      PanoramaSource source(panorama_config(file));
+      SourceConfig config = panorama_config(file);
+      config.panorama.layout = layout;
+      PanoramaSource source(config);
       ADD_FAILURE() << file << " was accepted";
     } catch (const AssetError& e) {
       EXPECT_NE(std::string(e.what()).find(file.string()), std::string::npos) << e.what();
@@ -92,8 +95,27 @@ TEST(PanoramaSource, RefusesBadFilesNamingThem) {
     }
   };
   refused(dir / "missing.png", "no such file");
+  // Square: not a mono panorama; a top/bottom pair by its shape (the "auto" layout), but not here
+  // with its eyes 3:1.
   cv::imwrite((dir / "square.png").string(), cv::Mat(64, 64, CV_8UC3, cv::Scalar(1, 2, 3)));
-  refused(dir / "square.png", "not 2:1");
+  refused(dir / "square.png", "not 2:1", PanoramaLayout::Equirect);
+  cv::imwrite((dir / "wide.png").string(), cv::Mat(64, 192, CV_8UC3, cv::Scalar(1, 2, 3)));
+  refused(dir / "wide.png", "not 2:1");
+  refused(dir / "wide.png", "not 1:1", PanoramaLayout::EquirectTopBottom);
+  refused(dir / "wide.png", "not 4:1", PanoramaLayout::EquirectLeftRight);
+  // A stereo viewpoint beside a mono one.
+  cv::imwrite((dir / "mono.png").string(), cv::Mat(64, 128, CV_8UC3, cv::Scalar(1, 2, 3)));
+  {
+    SourceConfig config = panorama_config(dir / "mono.png");
+    config.panorama.view.dwell_s = 1;
+    config.panorama.viewpoints.push_back({dir / "square.png", Vec3{0, 0, 0}, 0, 1});
+    try {
+      PanoramaSource source(config);
+      ADD_FAILURE() << "a mono and a stereo viewpoint were accepted together";
+    } catch (const AssetError& e) {
+      EXPECT_NE(std::string(e.what()).find("must all be mono or all stereo"), std::string::npos) << e.what();
+    }
+  }
   const std::filesystem::path ramp = write_ramp_panorama(dir);
   std::ifstream in(ramp, std::ios::binary);
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

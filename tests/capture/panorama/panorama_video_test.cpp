@@ -267,8 +267,10 @@ TEST(PanoramaVideo, SphericalMetadataThatIsNotMonoEquirectangularIsRefusedForWha
   // A layout the config does not say, or a shape that cannot hold it. (Packings other than
   // top/bottom and side by side are refused too; MP4's st3d box cannot hold them.)
   remux_with_metadata(plain, dir / "stereo.mp4", std::nullopt, 0, AV_STEREO3D_TOPBOTTOM);
-  refused(dir / "stereo.mp4", "its metadata says the layout is \"equirect-tb\" but source.panorama.layout is \"equirect\"");
+  refused(dir / "stereo.mp4", "its metadata says the layout is \"equirect-tb\" but source.panorama.layout is \"equirect\"",
+          PanoramaLayout::Equirect);
   refused(dir / "stereo.mp4", "is not 1:1", PanoramaLayout::EquirectTopBottom);
+  refused(dir / "stereo.mp4", "is not 1:1", PanoramaLayout::Auto);  // "auto": the metadata's word over the 2:1 shape
   refused(dir / "stereo.mp4", "says the layout is \"equirect-tb\" but source.panorama.layout is \"equirect-lr\"",
           PanoramaLayout::EquirectLeftRight);
   refused(dir / "equirect.mp4", "says the layout is \"equirect\" but source.panorama.layout is \"equirect-tb\"",
@@ -290,6 +292,8 @@ TEST(PanoramaVideo, AStereoVideoGivesEachTimeStepItsLeftThenItsRightEye) {
     {
       const PanoramaVideo video(file, layout);
       EXPECT_EQ(fmt::format("{}x{}", video.width(), video.height()), size);
+      // "auto": the shape says it (the file has no stereo metadata).
+      EXPECT_EQ(PanoramaVideo(file).layout(), layout);
     }
     SourceConfig config;
     config.type = SourceType::Panorama;

@@ -671,9 +671,9 @@ TEST(Config, AStereoPanoramaNamesItsLayoutRigAndOutput) {
   EXPECT_EQ(p.ods_rig().ipd_m, 0.063);
   EXPECT_NEAR(p.ods_rig().pole_merge_from_rad, 50 * std::numbers::pi / 180, 1e-15);
   EXPECT_NEAR(p.ods_rig().pole_merge_to_rad, 80 * std::numbers::pi / 180, 1e-15);
-  // The defaults: the left eye on top, 64 mm apart, merged from 60 to 75 degrees, packed top/bottom.
+  // The defaults: the layout from the file, 64 mm apart, merged from 60 to 75 degrees, packed top/bottom.
   const PanoramaConfig defaults;
-  EXPECT_EQ(defaults.layout, PanoramaLayout::Equirect);
+  EXPECT_EQ(defaults.layout, PanoramaLayout::Auto);
   EXPECT_EQ(defaults.view.stereo_output, StereoOutput::TopBottom);
   EXPECT_EQ(defaults.ods_rig(), OdsRig{});
   expect_error("[source.panorama]\npole_merge_from_deg = 70.0\npole_merge_to_deg = 65.0\n",
