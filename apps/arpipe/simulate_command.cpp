@@ -12,6 +12,7 @@
 #include "apps/cli/command_line.h"
 #include "apps/cli/progress_bar.h"
 #include "capture/recording/recording_reader.h"
+#include "capture/sim/scene_export.h"
 #include "capture/sim/sim_scene_loader.h"
 #include "capture/sinks/output_path.h"
 #include "capture/sinks/png_encoding.h"
@@ -28,6 +29,7 @@ struct SimulateOptions {
   sim::SimulateOptions simulate;
   int samples = 0;  // 0: the scene's render.samples_per_pixel
   bool png = false;  // also each frame as DIR/frame_NNNNNN.png
+  std::string export_glb;  // also the real objects and lights as this .glb
 };
 
 // Each frame of the recording in `dir` as dir/frame_NNNNNN.png (8-bit RGB): a still for
@@ -64,6 +66,17 @@ int run_simulate(SimulateOptions& command) {
     return 2;
   }
   if (samples > 0) scene.render.samples_per_pixel = samples;
+  if (!command.export_glb.empty()) {  // before the frames: a scene it cannot export fails fast
+    try {
+      const std::vector<uint8_t> glb = sim::export_scene_glb(scene);
+      if (const int error = replace_file(command.export_glb, glb))
+        throw std::runtime_error(fmt::format("{}: {}", command.export_glb, std::strerror(error)));
+      log::info("wrote the real objects and {} lights to {}", scene.lights.size(), command.export_glb);
+    } catch (const std::exception& e) {
+      log::error("{}: cannot export the scene: {}", scene_path, e.what());
+      return 1;
+    }
+  }
   sim::SimulateSummary summary;
   try {
     ProgressBar progress("frames");  // its line ends when it goes, before an error is logged
@@ -118,6 +131,10 @@ void add_simulate_command(CLI::App& arpipe) {
       }, "a square number"))
       ->default_str("the scene's");
   command->add_flag("--png", options->png, "also write each frame as DIR/frame_NNNNNN.png (a LENSMODEL_LONLAT camera's: a panorama)");
+  command->add_option("--export-glb", options->export_glb,
+                      "also write the real objects (one mesh in the world frame, for render.proxies) and the lights "
+                      "(KHR_lights_punctual, for light.panorama.lights_file) as a binary glTF")
+      ->type_name("FILE");
   cli::on_run(command, [options] { return run_simulate(*options); }, cli::Failure{.status = 1});
 }
 

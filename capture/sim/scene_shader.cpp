@@ -17,6 +17,7 @@
 
 #include "capture/sim/embree_scene.h"
 #include "capture/sim/light_sampling.h"
+#include "capture/sim/sim_object_mesh.h"
 #include "capture/sim/sim_textures.h"
 #include "core/scene/asset_error.h"
 #include "core/scene/builtin_meshes.h"
@@ -143,34 +144,7 @@ struct SceneShader::Impl {
         id = scene.add_sphere({origin, object.radius_m}, role);
         break;
       case SimObject::Shape::Mesh: {
-        check_object(object.mesh_scale > 0, object,
-                     fmt::format("mesh_scale must be positive, got {}", object.mesh_scale));
-        Mesh mesh;
-        try {
-          if (!object.mesh_builtin.empty()) {
-            if (object.mesh_size_m) {
-              const Vec3& size = *object.mesh_size_m;
-              const bool plane = object.mesh_builtin == "builtin:plane";
-              check_object(builtin_mesh_is_sized(object.mesh_builtin), object,
-                           fmt::format("\"{}\" has a fixed size; a size applies to \"builtin:box\", "
-                                       "\"builtin:cylinder\" and \"builtin:plane\"",
-                                       object.mesh_builtin));
-              check_object(std::isfinite(size[0]) && std::isfinite(size[1]) && std::isfinite(size[2]) &&
-                               size[0] > 0 && size[1] > 0 && (plane ? size[2] >= 0 : size[2] > 0),
-                           object, fmt::format("a mesh size must be finite and positive, got [{}, {}, {}] m", size[0],
-                                               size[1], size[2]));
-            }
-            auto builtin = object.mesh_size_m ? make_builtin_mesh(object.mesh_builtin, *object.mesh_size_m)
-                                              : make_builtin_mesh(object.mesh_builtin);
-            if (!builtin) throw AssetError(fmt::format("unknown builtin mesh \"{}\" (expected {})", object.mesh_builtin,
-                                                       kBuiltinMeshNames));
-            mesh = std::move(*builtin);
-          } else {
-            mesh = load_gltf_mesh(object.mesh_path);
-          }
-        } catch (const AssetError& e) {
-          throw AssetError(fmt::format("object \"{}\": {}", object.name, e.what()));
-        }
+        const Mesh mesh = sim_object_mesh(object);
         surface.kind = Surface::Kind::Mesh;
         std::vector<float> positions(mesh.positions.size());
         surface.normals.resize(mesh.positions.size());

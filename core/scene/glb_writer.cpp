@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstring>
@@ -100,7 +101,21 @@ void append_glb_u32(std::vector<uint8_t>& out, uint32_t value) {
 
 }  // namespace
 
-std::vector<uint8_t> encode_glb(const Mesh& mesh, std::string_view generator) {
+namespace {
+
+// The rotation (glTF's x, y, z, w) that turns a node's -z onto the unit vector d (glTF axes).
+std::array<double, 4> rotation_onto(const Vec3& d) {
+  const Vec3 a{0, 0, -1};
+  const double c = dot(a, d);
+  if (c < -1 + 1e-12) return {1, 0, 0, 0};  // opposite: half a turn about x
+  const Vec3 axis = cross(a, d);
+  const double w = 1 + c, length = std::sqrt(dot(axis, axis) + w * w);
+  return {axis[0] / length, axis[1] / length, axis[2] / length, w / length};
+}
+
+}  // namespace
+
+std::vector<uint8_t> encode_glb(const Mesh& mesh, std::string_view generator, const std::vector<GltfLight>& lights) {
   check_glb_encodable(mesh);
   std::vector<MeshPart> parts = mesh.parts;
   if (parts.empty()) parts.push_back(MeshPart{0, static_cast<uint32_t>(mesh.indices.size()), {1, 1, 1, 1}});
@@ -158,9 +173,32 @@ std::vector<uint8_t> encode_glb(const Mesh& mesh, std::string_view generator) {
   if (!mesh.source.empty()) node["name"] = mesh.source;
   json document = json::object();
   document["asset"] = {{"version", "2.0"}, {"generator", std::string(generator)}};
+  json nodes = json::array({std::move(node)}), scene_nodes = json::array({0});
+  if (!lights.empty()) {
+    json defined = json::array();
+    for (const GltfLight& light : lights) {
+      if (light.type != "directional" && light.type != "point")
+        throw std::invalid_argument(fmt::format("light \"{}\": a {} light, not directional or point", light.name, light.type));
+      json entry = {{"type", light.type}, {"color", {light.color[0], light.color[1], light.color[2]}}, {"intensity", light.intensity}};
+      if (!light.name.empty()) entry["name"] = light.name;
+      if (light.range > 0) entry["range"] = light.range;
+      defined.push_back(std::move(entry));
+      // Object (x, y, z) is glTF (x, z, -y).
+      const Vec3 d = normalized(light.direction);
+      const std::array<double, 4> q = rotation_onto({d[0], d[2], -d[1]});
+      json light_node = {{"rotation", {q[0], q[1], q[2], q[3]}},
+                         {"extensions", {{"KHR_lights_punctual", {{"light", defined.size() - 1}}}}}};
+      if (light.type == "point") light_node["translation"] = {light.position[0], light.position[2], -light.position[1]};
+      if (!light.name.empty()) light_node["name"] = light.name;
+      scene_nodes.push_back(nodes.size());
+      nodes.push_back(std::move(light_node));
+    }
+    document["extensionsUsed"] = json::array({"KHR_lights_punctual"});
+    document["extensions"] = {{"KHR_lights_punctual", {{"lights", std::move(defined)}}}};
+  }
   document["scene"] = 0;
-  document["scenes"] = json::array({json{{"nodes", json::array({0})}}});
-  document["nodes"] = json::array({std::move(node)});
+  document["scenes"] = json::array({json{{"nodes", std::move(scene_nodes)}}});
+  document["nodes"] = std::move(nodes);
   document["meshes"] = json::array({json{{"primitives", std::move(primitives)}}});
   document["materials"] = std::move(materials);
   document["accessors"] = std::move(builder.accessors());

@@ -6,6 +6,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/scene/gltf_loader.h"
 #include "core/scene/mesh.h"
 
 namespace arpipe {
@@ -17,6 +18,8 @@ namespace arpipe {
 // Throws std::invalid_argument for a mesh that is not one (no triangles, an index past the last
 // vertex, a position or normal not finite, normals not one per vertex, a part outside the indices)
 // or too large for a .glb's 32-bit lengths.
-std::vector<uint8_t> encode_glb(const Mesh& mesh, std::string_view generator);
+// lights: KHR_lights_punctual lights ("directional" or "point"), each on a node of its own placed
+// so that load_gltf_lights reads back its position and direction (z-up, as the mesh).
+std::vector<uint8_t> encode_glb(const Mesh& mesh, std::string_view generator, const std::vector<GltfLight>& lights = {});
 
 }  // namespace arpipe

@@ -40,7 +40,8 @@ TEST(PanoramaReplay, TheHybridExampleRunsFromTheSimulatedStill) {
   const fs::path out = out_dir("panorama");
   std::string stderr_text;
   ASSERT_EQ(test::run_to_exit(test::build_program("arpipe"),
-                              {"simulate", "--scene", kScene.string(), "--out", (out / "still").string(), "--png"},
+                              {"simulate", "--scene", kScene.string(), "--out", (out / "still").string(), "--png",
+                               "--export-glb", (out / "world.glb").string()},
                               out / "logs-simulate", &stderr_text),
             0)
       << stderr_text;
@@ -101,6 +102,25 @@ TEST(PanoramaReplay, TheHybridExampleRunsFromTheSimulatedStill) {
       EXPECT_NEAR(light["lights"][0]["direction_world"][k].get<double>(), config.render.light_direction[k], 1e-12);
   }
   EXPECT_EQ(lit_lines, 2);
+
+  // The scene's own lights, exported by the simulator with its real objects: the sun the config's
+  // render.light_direction copies (to 4 decimals) comes back as the frame's light.
+  ASSERT_TRUE(fs::exists(out / "world.glb"));
+  std::vector<std::string> exported_overrides = overrides;
+  exported_overrides.insert(exported_overrides.end(),
+                            {"light.source=\"panorama\"", "source.panorama.view.frames=1",
+                             "light.panorama.lights_file=\"" + (out / "world.glb").string() + "\"",
+                             "sinks.results.path=\"" + (out / "exported.jsonl").string() + "\""});
+  args = {"--config", kConfig.string()};
+  for (const std::string& o : exported_overrides) args.insert(args.end(), {"--set", o});
+  ASSERT_EQ(test::run_to_exit(test::build_program("arpiped"), args, out / "logs-exported", &stderr_text), 0) << stderr_text;
+  std::ifstream exported(out / "exported.jsonl");
+  std::string line;
+  ASSERT_TRUE(std::getline(exported, line));
+  const nlohmann::json exported_light = nlohmann::json::parse(line)["light"];
+  ASSERT_EQ(exported_light["lights"].size(), 1u) << line;
+  for (size_t k = 0; k < 3; ++k)
+    EXPECT_NEAR(exported_light["lights"][0]["direction_world"][k].get<double>(), config.render.light_direction[k], 1e-4) << line;
   fs::remove_all(out);
 }
 

@@ -1,0 +1,31 @@
+// A simulator scene's real world as the hybrid viewer's inputs (seed 003: the pre-rendered scene
+// exports its geometry as proxies and its lights): every real object's triangles in the world
+// frame in one mesh (a part per object, named by it, its albedo as the base colour), for
+// render.proxies, and its lights as KHR_lights_punctual, for light.panorama.lights_file, in one
+// binary glTF. `arpipe simulate --export-glb FILE` writes it.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "capture/sim/sim_scene.h"
+#include "core/scene/gltf_loader.h"
+#include "core/scene/mesh.h"
+
+namespace arpipe::sim {
+
+// The real objects (not the virtual ones) in the world frame: planes as their rectangles, spheres
+// tessellated (24 rings), meshes at their size and scale. Throws AssetError or
+// std::invalid_argument naming an object that cannot be made.
+Mesh real_world_mesh(const SimScene& scene);
+
+// The lights: directional ones (the sun among them) with their irradiance (W/m^2) as the
+// intensity; point and sphere lights as points with their radiant intensity (W/sr), a sphere's
+// size dropped. glTF's units are lux and candela: light.panorama.lights_scale converts.
+std::vector<GltfLight> scene_lights(const SimScene& scene);
+
+// Both as a .glb (core/scene/glb_writer.h). Throws as above, or std::invalid_argument for a scene
+// with no real object.
+std::vector<uint8_t> export_scene_glb(const SimScene& scene);
+
+}  // namespace arpipe::sim
