@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <stdexcept>
 
 #include "core/log.h"
@@ -14,6 +15,7 @@
 #include "core/scene/builtin_meshes.h"
 #include "core/scene/gltf_loader.h"
 #include "core/scene/mesh_convexity.h"
+#include "core/scene/mesh_subdivide.h"
 #include "render/prt/prt_cache.h"
 #include "render/proxy_clusters.h"
 
@@ -172,12 +174,25 @@ std::vector<UploadedObject> upload_proxies(const Config& config, const LoadedMes
     throw std::logic_error(fmt::format("upload_proxies: {} proxies loaded for a config with {}", loaded.proxies.size(),
                                        config.render.proxies.size()));
   std::vector<UploadedObject> out;
+  // A stereo panorama's eyes move each point by its own offset (ods_projection.h), which straight
+  // edges between projected vertices do not follow: proxies, often a room's walls and floors, are
+  // cut into triangles of at most kOdsMaxEdgeM, and their coarser occluder levels left out.
+  const bool stereo_possible =
+      config.source.type == SourceType::Panorama && config.source.panorama.layout != PanoramaLayout::Equirect;
   for (size_t i = 0; i < config.render.proxies.size(); ++i) {
     const SceneProxy& proxy = config.render.proxies[i];
     UploadedObject object;
     object.mesh_source = proxy.mesh;
     object.name = proxy.name.empty() ? fmt::format("proxy {}", i) : proxy.name;
-    ClusteredMesh clustered = cluster_for_culling(*loaded.proxies[i].mesh);
+    std::optional<Mesh> cut;
+    if (stereo_possible) {
+      double edge_m = 0;
+      cut = subdivided(*loaded.proxies[i].mesh, kOdsMaxEdgeM / proxy.scale, kMaxStereoProxyTriangles, &edge_m);
+      if (edge_m * proxy.scale > kOdsMaxEdgeM * 1.0001)
+        log::warn("proxy {}: cut to edges of {:.3g} m for stereo (not {} m: at most {} triangles)", object.name,
+                  edge_m * proxy.scale, kOdsMaxEdgeM, kMaxStereoProxyTriangles);
+    }
+    ClusteredMesh clustered = cluster_for_culling(cut ? *cut : *loaded.proxies[i].mesh);
     object.mesh = std::make_shared<const GpuMesh>(clustered.mesh);
     for (const Bounds& b : clustered.bounds) object.cluster_bounds.push_back(scaled(b, proxy.scale));
     object.scale = proxy.scale;
@@ -190,7 +205,7 @@ std::vector<UploadedObject> upload_proxies(const Config& config, const LoadedMes
     object.viewpoint = proxy.viewpoint;
     object.base_color = std::array<float, 4>{0, 0, 0, 0};
     std::string sizes;
-    for (const OccluderLevel& level : loaded.proxies[i].occluder_levels) {
+    for (const OccluderLevel& level : cut ? std::vector<OccluderLevel>{} : loaded.proxies[i].occluder_levels) {
       object.occluder_levels.push_back(std::make_shared<const GpuMesh>(*level.mesh));
       object.occluder_level_errors_m.push_back(level.error * proxy.scale);
       sizes += fmt::format(", {} ({:.2g} mm)", level.mesh->triangle_count(), 1e3 * object.occluder_level_errors_m.back());
