@@ -11,6 +11,7 @@
 #include "apps/arpipe/commands.h"
 #include "apps/cli/command_line.h"
 #include "apps/cli/progress_bar.h"
+#include "capture/panorama/panorama_video_writer.h"
 #include "capture/recording/recording_reader.h"
 #include "capture/sim/scene_export.h"
 #include "capture/sim/sim_scene_loader.h"
@@ -30,7 +31,26 @@ struct SimulateOptions {
   int samples = 0;  // 0: the scene's render.samples_per_pixel
   bool png = false;  // also each frame as DIR/frame_NNNNNN.png
   std::string export_glb;  // also the real objects and lights as this .glb
+  std::string video;       // also the frames as this 360° MP4 (a LENSMODEL_LONLAT camera's)
 };
+
+// The recording in `dir` as a 360° H.264 MP4 at the scene's frame rate, with the spherical
+// metadata of its layout: what source.panorama.file reads as a video.
+void write_frames_as_video(const std::filesystem::path& dir, const std::filesystem::path& file, const sim::SimCamera& camera) {
+  const RecordingReader reader(dir);
+  const PanoramaLayout layout = !camera.stereo.enabled ? PanoramaLayout::Equirect
+                                : camera.stereo.top_bottom ? PanoramaLayout::EquirectTopBottom
+                                                           : PanoramaLayout::EquirectLeftRight;
+  PanoramaVideoWriter writer(file, camera.frame_width(), camera.frame_height(), camera.fps, layout);
+  Frame frame;
+  std::vector<uint8_t> rgb;
+  for (size_t i = 0; i < reader.frame_count(); ++i) {
+    reader.read(i, frame);
+    to_rgb24(frame, rgb);
+    writer.write(rgb.data(), size_t(frame.width) * 3);
+  }
+  writer.finish();
+}
 
 // Each frame of the recording in `dir` as dir/frame_NNNNNN.png (8-bit RGB): a still for
 // source.panorama.file when the camera is an equirectangular LENSMODEL_LONLAT, or a picture to look at.
@@ -66,6 +86,11 @@ int run_simulate(SimulateOptions& command) {
     return 2;
   }
   if (samples > 0) scene.render.samples_per_pixel = samples;
+  if (!command.video.empty() && scene.camera.model.lensmodel() != "LENSMODEL_LONLAT") {
+    log::error("{}: --video writes 360° videos: the camera must be LENSMODEL_LONLAT, not {}", scene_path,
+               scene.camera.model.lensmodel());
+    return 2;
+  }
   if (!command.export_glb.empty()) {  // before the frames: a scene it cannot export fails fast
     try {
       const std::vector<uint8_t> glb = sim::export_scene_glb(scene);
@@ -91,6 +116,15 @@ int run_simulate(SimulateOptions& command) {
       write_frames_as_png(options.out_dir);
     } catch (const std::exception& e) {
       log::error("writing the frames as PNG: {}", e.what());
+      return 1;
+    }
+  }
+  if (!command.video.empty()) {
+    try {
+      write_frames_as_video(options.out_dir, command.video, scene.camera);
+      log::info("wrote the frames as {}", command.video);
+    } catch (const std::exception& e) {
+      log::error("writing the frames as a video: {}", e.what());
       return 1;
     }
   }
@@ -134,6 +168,10 @@ void add_simulate_command(CLI::App& arpipe) {
   command->add_option("--export-glb", options->export_glb,
                       "also write the real objects (one mesh in the world frame, for render.proxies) and the lights "
                       "(KHR_lights_punctual, for light.panorama.lights_file) as a binary glTF")
+      ->type_name("FILE");
+  command->add_option("--video", options->video,
+                      "also write the frames as a 360° H.264 MP4 with spherical metadata (a LENSMODEL_LONLAT camera's, "
+                      "mono or its [camera.stereo] pair)")
       ->type_name("FILE");
   cli::on_run(command, [options] { return run_simulate(*options); }, cli::Failure{.status = 1});
 }

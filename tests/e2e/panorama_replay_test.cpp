@@ -17,6 +17,7 @@
 #include "capture/panorama/equirect_image.h"
 #include "capture/panorama/panorama_light.h"
 #include "capture/panorama/panorama_source.h"
+#include "capture/panorama/panorama_video.h"
 #include "core/environment/hdr_environment.h"
 #include "core/config/config.h"
 #include "tests/e2e/child_process.h"
@@ -176,6 +177,51 @@ TEST(PanoramaReplay, AStereoStillGivesBothEyesPackedOrAsFramesOfTheirOwn) {
     EXPECT_EQ(frames[k]["eye"], k % 2 == 0 ? "left" : "right");
     EXPECT_EQ(frames[k]["exposure_start_ns"], frames[k - k % 2]["exposure_start_ns"]);
   }
+  fs::remove_all(out);
+}
+
+TEST(PanoramaReplay, SimulateWritesAStereoVideoTheSourceReads) {
+  // A 128 x 64 omnidirectional-stereo pair, top/bottom, 3 frames, as an MP4 with its metadata.
+  const fs::path out = out_dir("panorama-sim-video");
+  std::ofstream(out / "scene.toml") << R"([camera]
+lensmodel = "LENSMODEL_LONLAT"
+intrinsics = [20.371832715762604, 20.371832715762604, 63.5, 31.5]
+width = 128
+height = 64
+pixel_format = "RGB24"
+[camera.stereo]
+layout = "tb"
+[camera.sensor]
+noise = false
+[render]
+samples_per_pixel = 1
+frames = 3
+[environment]
+radiance = [0.3, 0.5, 0.8]
+[[object]]
+shape = "sphere"
+radius_m = 0.2
+position = [0.0, 1.0, 0.0]
+albedo = [0.9, 0.2, 0.1]
+)";
+  std::string stderr_text;
+  ASSERT_EQ(test::run_to_exit(test::build_program("arpipe"),
+                              {"simulate", "--scene", (out / "scene.toml").string(), "--out", (out / "rec").string(),
+                               "--video", (out / "pair.mp4").string()},
+                              out / "logs", &stderr_text),
+            0)
+      << stderr_text;
+  PanoramaVideo video(out / "pair.mp4");
+  EXPECT_EQ(video.layout(), PanoramaLayout::EquirectTopBottom);  // from its metadata
+  PanoramaVideoFrame frame;
+  int frames = 0;
+  while (video.next(frame)) {
+    EXPECT_EQ(frame.width, 128);
+    EXPECT_EQ(frame.height, 128);
+    EXPECT_EQ(frame.index, frames);
+    ++frames;
+  }
+  EXPECT_EQ(frames, 3);
   fs::remove_all(out);
 }
 
