@@ -17,6 +17,7 @@ extern "C" {
 #include <utility>
 
 #include "capture/panorama/equirect_image.h"
+#include "capture/panorama/ffmpeg_error.h"
 #include "core/log.h"
 #include "core/scene/asset_error.h"
 
@@ -25,12 +26,6 @@ namespace {
 
 constexpr const char* kDemuxers = "mov,mp4,m4a,3gp,3g2,mj2,matroska,webm";
 constexpr const char* kDecoders = "h264,hevc,vp8,vp9,av1,libdav1d,libaom-av1";
-
-std::string av_error(int code) {
-  char text[AV_ERROR_MAX_STRING_SIZE] = {};
-  av_strerror(code, text, sizeof text);
-  return text;
-}
 
 }  // namespace
 
@@ -149,9 +144,9 @@ PanoramaVideo::PanoramaVideo(const std::filesystem::path& file, PanoramaLayout l
   av_dict_free(&options);
   if (error < 0) {
     s.format = nullptr;  // freed by avformat_open_input
-    s.fail(fmt::format("cannot open it as MP4, MOV, MKV or WebM: {}", av_error(error)));
+    s.fail(fmt::format("cannot open it as MP4, MOV, MKV or WebM: {}", ffmpeg_error(error)));
   }
-  if ((error = avformat_find_stream_info(s.format, nullptr)) < 0) s.fail(fmt::format("no stream information: {}", av_error(error)));
+  if ((error = avformat_find_stream_info(s.format, nullptr)) < 0) s.fail(fmt::format("no stream information: {}", ffmpeg_error(error)));
   const AVCodec* decoder = nullptr;
   s.stream = av_find_best_stream(s.format, AVMEDIA_TYPE_VIDEO, -1, -1, &decoder, 0);
   if (s.stream < 0 || !decoder) s.fail("no video stream that H.264, HEVC, VP8, VP9 or AV1 decoding reads");
@@ -168,7 +163,7 @@ PanoramaVideo::PanoramaVideo(const std::filesystem::path& file, PanoramaLayout l
   s.codec = avcodec_alloc_context3(decoder);
   if (!s.codec || avcodec_parameters_to_context(s.codec, parameters) < 0) s.fail("cannot set up its decoder");
   s.codec->thread_count = 0;  // FFmpeg's choice: one per core
-  if ((error = avcodec_open2(s.codec, decoder, nullptr)) < 0) s.fail(fmt::format("cannot open its {} decoder: {}", decoder->name, av_error(error)));
+  if ((error = avcodec_open2(s.codec, decoder, nullptr)) < 0) s.fail(fmt::format("cannot open its {} decoder: {}", decoder->name, ffmpeg_error(error)));
   s.time_base = stream->time_base;
   s.rate = stream->avg_frame_rate.num > 0 && stream->avg_frame_rate.den > 0 ? stream->avg_frame_rate : stream->r_frame_rate;
   if (s.rate.num <= 0 || s.rate.den <= 0 || s.time_base.num <= 0 || s.time_base.den <= 0) s.fail("no frame rate or time base");
@@ -218,7 +213,7 @@ bool PanoramaVideo::next(PanoramaVideoFrame& out) {
     }
     if (received != AVERROR(EAGAIN)) {
       ++s.decode_errors;
-      log::debug("panorama video {}: {}", s.file.string(), av_error(received));
+      log::debug("panorama video {}: {}", s.file.string(), ffmpeg_error(received));
     }
     if (s.draining) {
       if (received == AVERROR(EAGAIN)) s.ended = true;
@@ -241,7 +236,7 @@ void PanoramaVideo::seek(int64_t index) {
   Impl& s = *impl_;
   const int64_t target = s.start_pts + av_rescale_q(std::max<int64_t>(index, 0), av_inv_q(s.rate), s.time_base);
   const int error = av_seek_frame(s.format, s.stream, target, AVSEEK_FLAG_BACKWARD);
-  if (error < 0) s.fail(fmt::format("cannot seek to frame {}: {}", index, av_error(error)));
+  if (error < 0) s.fail(fmt::format("cannot seek to frame {}: {}", index, ffmpeg_error(error)));
   avcodec_flush_buffers(s.codec);
   s.draining = s.ended = false;
   s.skip_before = std::max<int64_t>(index, 0);

@@ -15,18 +15,10 @@ extern "C" {
 #include <cmath>
 #include <stdexcept>
 
+#include "capture/panorama/ffmpeg_error.h"
 #include "core/log.h"
 
 namespace arpipe {
-namespace {
-
-std::string av_error(int code) {
-  char text[AV_ERROR_MAX_STRING_SIZE] = {};
-  av_strerror(code, text, sizeof text);
-  return text;
-}
-
-}  // namespace
 
 struct PanoramaVideoWriter::Impl {
   std::filesystem::path file;
@@ -58,13 +50,13 @@ struct PanoramaVideoWriter::Impl {
   // Sends `input` (nullptr: the end) and writes every packet the encoder gives back.
   void encode(const AVFrame* input) {
     int error = avcodec_send_frame(codec, input);
-    if (error < 0) fail(fmt::format("encoding: {}", av_error(error)));
+    if (error < 0) fail(fmt::format("encoding: {}", ffmpeg_error(error)));
     while ((error = avcodec_receive_packet(codec, packet)) == 0) {
       av_packet_rescale_ts(packet, codec->time_base, stream->time_base);
       packet->stream_index = stream->index;
-      if ((error = av_interleaved_write_frame(format, packet)) < 0) fail(fmt::format("writing: {}", av_error(error)));
+      if ((error = av_interleaved_write_frame(format, packet)) < 0) fail(fmt::format("writing: {}", ffmpeg_error(error)));
     }
-    if (error != AVERROR(EAGAIN) && error != AVERROR_EOF) fail(fmt::format("encoding: {}", av_error(error)));
+    if (error != AVERROR(EAGAIN) && error != AVERROR_EOF) fail(fmt::format("encoding: {}", ffmpeg_error(error)));
   }
 };
 
@@ -81,7 +73,7 @@ PanoramaVideoWriter::PanoramaVideoWriter(const std::filesystem::path& file, int 
   const AVCodec* encoder = avcodec_find_encoder_by_name("libx264");
   if (!encoder) s.fail("FFmpeg's libraries have no libx264 encoder");
   int error = avformat_alloc_output_context2(&s.format, nullptr, "mp4", file.c_str());
-  if (error < 0 || !s.format) s.fail(fmt::format("cannot make an MP4: {}", av_error(error)));
+  if (error < 0 || !s.format) s.fail(fmt::format("cannot make an MP4: {}", ffmpeg_error(error)));
   s.stream = avformat_new_stream(s.format, nullptr);
   s.codec = avcodec_alloc_context3(encoder);
   s.frame = av_frame_alloc();
@@ -98,7 +90,7 @@ PanoramaVideoWriter::PanoramaVideoWriter(const std::filesystem::path& file, int 
   if (s.format->oformat->flags & AVFMT_GLOBALHEADER) s.codec->flags |= AV_CODEC_FLAG_GLOBAL_HEADER;
   av_opt_set(s.codec->priv_data, "preset", "medium", 0);
   av_opt_set_int(s.codec->priv_data, "crf", crf, 0);
-  if ((error = avcodec_open2(s.codec, encoder, nullptr)) < 0) s.fail(fmt::format("cannot open libx264: {}", av_error(error)));
+  if ((error = avcodec_open2(s.codec, encoder, nullptr)) < 0) s.fail(fmt::format("cannot open libx264: {}", ffmpeg_error(error)));
   if ((error = avcodec_parameters_from_context(s.stream->codecpar, s.codec)) < 0) s.fail("cannot describe the stream");
   s.stream->time_base = s.codec->time_base;
   s.stream->avg_frame_rate = rate;
@@ -122,8 +114,8 @@ PanoramaVideoWriter::PanoramaVideoWriter(const std::filesystem::path& file, int 
     s.fail("cannot attach its stereo metadata");
   }
   s.format->strict_std_compliance = FF_COMPLIANCE_UNOFFICIAL;  // the MP4 muxer writes sv3d and st3d only so
-  if ((error = avio_open(&s.format->pb, file.c_str(), AVIO_FLAG_WRITE)) < 0) s.fail(fmt::format("cannot open it: {}", av_error(error)));
-  if ((error = avformat_write_header(s.format, nullptr)) < 0) s.fail(fmt::format("cannot write its header: {}", av_error(error)));
+  if ((error = avio_open(&s.format->pb, file.c_str(), AVIO_FLAG_WRITE)) < 0) s.fail(fmt::format("cannot open it: {}", ffmpeg_error(error)));
+  if ((error = avformat_write_header(s.format, nullptr)) < 0) s.fail(fmt::format("cannot write its header: {}", ffmpeg_error(error)));
 
   s.frame->format = AV_PIX_FMT_YUV420P;
   s.frame->width = width;
@@ -161,7 +153,7 @@ void PanoramaVideoWriter::finish() {
   s.finished = true;
   s.encode(nullptr);
   const int error = av_write_trailer(s.format);
-  if (error < 0) s.fail(fmt::format("cannot write its index: {}", av_error(error)));
+  if (error < 0) s.fail(fmt::format("cannot write its index: {}", ffmpeg_error(error)));
 }
 
 }  // namespace arpipe
