@@ -35,6 +35,9 @@ constexpr int kExposureInstants = 8;  // pieces of the exposure whose ends bound
 // frame-to-frame jitter does not redraw it every frame (a shadow 10 cm long moves 0.1 mm).
 constexpr double kRadiansPerDegree = std::numbers::pi / 180;
 constexpr double kShadowLightStepRad = 0.05 * kRadiansPerDegree;
+// The ground catcher's square split per side when its vertices move non-linearly (a lens per
+// vertex, a stereo panorama's eye), so that it bends like the ground.
+constexpr int kBentReceiverSubdivisions = 16;
 
 // What the render stage's loader reads away from the processing thread: the objects' meshes and
 // their PRT transfers, on the CPU.
@@ -76,7 +79,9 @@ void RenderStage::configure_loaded(const Config& config, const std::shared_ptr<c
   if (!drawer_) drawer_ = std::make_unique<MotionBlurDrawer>(session_->context(), session_->layer().color_format());
   drawer_->prepare(config.render.blur.method);
   std::vector<UploadedObject> objects = upload_objects(config, loaded->meshes);
-  std::vector<UploadedObject> proxies = upload_proxies(config, loaded->meshes);
+  // A stereo layout's proxies are cut for its eyes now; an "auto" one's on its first eye's frame.
+  const bool stereo = config.source.type == SourceType::Panorama && is_stereo(config.source.panorama.layout);
+  std::vector<UploadedObject> proxies = upload_proxies(config, loaded->meshes, stereo);
   auto physics = std::make_unique<ScenePhysics>(config, loaded->meshes);
   if (physics->empty()) physics.reset();
   std::unique_ptr<OcclusionMeter> occlusion_meter;
@@ -108,8 +113,9 @@ void RenderStage::configure_loaded(const Config& config, const std::shared_ptr<c
   } else if (!shadow_pass_ || shadow_pass_->config() != settings.shadows) {
     shadow_pass_ = std::make_unique<ShadowMapPass>(session_->context(), settings.shadows);
   }
-  // Split so that lens distortion applied per vertex bends it like the ground in the image.
-  const int receiver_subdivisions = settings.lens == LensMode::Vertex ? 16 : 1;
+  // Split so that lens distortion applied per vertex, or a stereo panorama's eye offset
+  // (core/geometry/ods_projection.h), bends it like the ground in the image.
+  const int receiver_subdivisions = settings.lens == LensMode::Vertex || stereo ? kBentReceiverSubdivisions : 1;
   if (!receiver_ || receiver_->subdivisions() != receiver_subdivisions)
     receiver_ = std::make_unique<ShadowReceiver>(receiver_subdivisions);
   // The real casters' map: a depth map for the catcher's real visibility (shadow_lookup_glsl.h).
@@ -127,6 +133,9 @@ void RenderStage::configure_loaded(const Config& config, const std::shared_ptr<c
 
   objects_ = std::move(objects);
   proxies_ = std::move(proxies);
+  proxies_cut_for_stereo_ = stereo;
+  assets_ = assets;
+  proxy_config_ = config;
   physics_ = std::move(physics);
   occlusion_meter_ = std::move(occlusion_meter);
   reuse_.forget();  // new objects or settings: draw again
@@ -156,6 +165,20 @@ std::shared_ptr<const CameraModel> RenderStage::pinhole_core(const std::shared_p
     check_lens_undistortable(model);
     return CameraModel::pinhole(model.fx(), model.fy(), model.cx(), model.cy(), model.width(), model.height());
   });
+}
+
+void RenderStage::prepare_for_stereo() {
+  // The first eye's frame of an "auto" layout that turned out stereo: the proxies cut for the
+  // eyes' offsets, the ground catcher's square split.
+  if (!proxies_cut_for_stereo_ && !proxies_.empty()) {
+    const auto* loaded = dynamic_cast<const RenderAssets*>(assets_.get());
+    if (!loaded) throw std::logic_error("RenderStage: no assets to cut the proxies from");
+    proxies_ = upload_proxies(proxy_config_, loaded->meshes, true);
+    reuse_.forget();
+  }
+  proxies_cut_for_stereo_ = true;
+  if (receiver_ && receiver_->subdivisions() < kBentReceiverSubdivisions)
+    receiver_ = std::make_unique<ShadowReceiver>(kBentReceiverSubdivisions);
 }
 
 // FrameContext::virtual_layer carries the texture's name without the GL headers.
@@ -235,6 +258,7 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
     motion.T_cam_world_start = motion.T_cam_world_mid = motion.T_cam_world_end = ctx.pose.T_cam_world;
     motion.max_image_motion_px = 0;
   }
+  if (ctx.camera.meta.eye != Eye::Mono) prepare_for_stereo();
   if (physics_) physics_->set_viewpoint(ctx.camera.meta.viewpoint);  // its proxies' colliders only
   if (physics_ && move_objects(motion)) reuse_.forget();
   if (physics_) {

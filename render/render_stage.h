@@ -76,6 +76,8 @@ class RenderStage final : public Stage {
   };
   enum class Drawn { Yes, Reused, OutOfView };
   Drawn draw(FrameContext& ctx);
+  // Cuts the proxies and splits the catcher for a stereo panorama's eyes, once.
+  void prepare_for_stereo();
   Lighting frame_lighting(const FrameContext& ctx, double& angular_diameter_rad) const;
   // The shadow map for this frame's light, or nullptr (ctx gets a "shadow" timing saying why).
   // redrawn: whether the map changed (a layer drawn with the old one cannot be reused).
@@ -105,6 +107,11 @@ class RenderStage final : public Stage {
   PerModelCache<CameraModel> pinhole_cores_;  // render.lens = "undistort": what the output sees
   std::vector<UploadedObject> objects_;
   std::vector<UploadedObject> proxies_;  // [[render.proxies]], in config order
+  // Whether proxies_ are cut for a stereo panorama's eyes (uploaded_objects.h); the meshes and the
+  // config they came from, to cut them when an "auto" layout's first eye's frame comes.
+  bool proxies_cut_for_stereo_ = false;
+  std::shared_ptr<const StageAssets> assets_;
+  Config proxy_config_;
   std::unique_ptr<ScenePhysics> physics_;  // nullptr when no object has a physics kind
   std::unique_ptr<OcclusionMeter> occlusion_meter_;  // with proxies or physics: ctx.objects
   LayerReuse reuse_;

@@ -169,7 +169,7 @@ SE3 proxy_placement(const SceneProxy& proxy) {
          SE3::from_rt({proxy.roll_rad, 0, 0}, {0, 0, 0});
 }
 
-std::vector<UploadedObject> upload_proxies(const Config& config, const LoadedMeshes& loaded) {
+std::vector<UploadedObject> upload_proxies(const Config& config, const LoadedMeshes& loaded, bool cut_for_stereo) {
   if (loaded.proxies.size() != config.render.proxies.size())
     throw std::logic_error(fmt::format("upload_proxies: {} proxies loaded for a config with {}", loaded.proxies.size(),
                                        config.render.proxies.size()));
@@ -177,15 +177,13 @@ std::vector<UploadedObject> upload_proxies(const Config& config, const LoadedMes
   // A stereo panorama's eyes move each point by its own offset (ods_projection.h), which straight
   // edges between projected vertices do not follow: proxies, often a room's walls and floors, are
   // cut into triangles of at most kOdsMaxEdgeM, and their coarser occluder levels left out.
-  const bool stereo_possible =
-      config.source.type == SourceType::Panorama && config.source.panorama.layout != PanoramaLayout::Equirect;
   for (size_t i = 0; i < config.render.proxies.size(); ++i) {
     const SceneProxy& proxy = config.render.proxies[i];
     UploadedObject object;
     object.mesh_source = proxy.mesh;
     object.name = proxy.name.empty() ? fmt::format("proxy {}", i) : proxy.name;
     std::optional<Mesh> cut;
-    if (stereo_possible) {
+    if (cut_for_stereo) {
       double edge_m = 0;
       cut = subdivided(*loaded.proxies[i].mesh, kOdsMaxEdgeM / proxy.scale, kMaxStereoProxyTriangles, &edge_m);
       if (edge_m * proxy.scale > kOdsMaxEdgeM * 1.0001)

@@ -96,7 +96,9 @@ LoadedMeshes load_object_meshes(const Config& config);
 // GL context.
 std::vector<UploadedObject> upload_objects(const Config& config, const LoadedMeshes& loaded);
 // The same for render.proxies (UploadedObject::proxy), in config order.
-std::vector<UploadedObject> upload_proxies(const Config& config, const LoadedMeshes& loaded);
+// cut_for_stereo: each cut into triangles of at most kOdsMaxEdgeM, without its coarser occluder
+// levels (for a stereo panorama's eyes).
+std::vector<UploadedObject> upload_proxies(const Config& config, const LoadedMeshes& loaded, bool cut_for_stereo = false);
 // A proxy's placement: R = Rz(yaw) Ry(pitch) Rx(roll), at position_m.
 SE3 proxy_placement(const SceneProxy& proxy);
 

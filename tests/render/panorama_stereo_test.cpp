@@ -213,6 +213,9 @@ TEST(PanoramaStereo, AProxyEdgeAcrossTheViewFollowsItsRealEdgeInEachEye) {
   // cells, the edge was 1.8 px off on average and 3.8 px at most, measured once).
   const Ball look{180, -35, 1.0};
   Config config = stereo_config(look);
+  // "auto": the 1:1 still is a top/bottom pair, and the render stage cuts the proxies when the
+  // first eye's frame comes.
+  config.source.panorama.layout = PanoramaLayout::Auto;
   SceneObject floor;
   floor.mesh = "builtin:plane";  // 6 cm across, scaled to 9.6 m
   floor.scale = 160;
