@@ -32,8 +32,9 @@ HdrImage left_eye(HdrImage whole) {
 
 }  // namespace
 
-PanoramaPlace::PanoramaPlace(const PanoramaViewpoint& viewpoint, PanoramaLayout layout, bool carries_light)
-    : viewpoint_(viewpoint), layout_(layout), is_video_(panorama_file_kind(viewpoint.file) == PanoramaFileKind::Video) {
+PanoramaPlace::PanoramaPlace(const PanoramaViewpoint& viewpoint, PanoramaLayout layout, bool carries_light,
+                             bool hardware_decoding)
+    : viewpoint_(viewpoint), layout_(layout), hardware_decoding_(hardware_decoding), is_video_(panorama_file_kind(viewpoint.file) == PanoramaFileKind::Video) {
   const Mat3 R_world_pano = default_world_from_probe(viewpoint.yaw_rad);
   if (is_video_) {
     arrive();  // checks that a frame decodes
@@ -61,7 +62,7 @@ PanoramaPlace::PanoramaPlace(PanoramaPlace&&) noexcept = default;
 
 void PanoramaPlace::arrive() {
   if (!is_video_) return;
-  video_ = std::make_unique<PanoramaVideo>(viewpoint_.file, layout_);
+  video_ = std::make_unique<PanoramaVideo>(viewpoint_.file, layout_, hardware_decoding_);
   video_frame_ns_ = std::max<int64_t>(1, (1'000'000'000 * video_->rate_den() + video_->rate_num() / 2) / video_->rate_num());
   loop_offset_ns_ = 0;
   if (!video_->next(shown_)) throw AssetError(fmt::format("panorama video \"{}\": no frame decodes", viewpoint_.file.string()));

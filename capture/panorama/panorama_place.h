@@ -22,7 +22,9 @@ class PanoramaPlace {
   // leave()). carries_light: the panorama's SH too (a still's from every texel, an HDR still's
   // unclipped; a video's from each frame shown). Throws AssetError naming the file.
   // layout: how its file holds the sphere (a stereo pair: both eyes; the light is the left eye's).
-  PanoramaPlace(const PanoramaViewpoint& viewpoint, PanoramaLayout layout, bool carries_light);
+  // hardware_decoding: a video tries the board's decoder first (panorama_video.h).
+  PanoramaPlace(const PanoramaViewpoint& viewpoint, PanoramaLayout layout, bool carries_light,
+                bool hardware_decoding = false);
   ~PanoramaPlace();
   PanoramaPlace(PanoramaPlace&&) noexcept;
 
@@ -52,6 +54,7 @@ class PanoramaPlace {
 
   PanoramaViewpoint viewpoint_;
   PanoramaLayout layout_ = PanoramaLayout::Equirect;
+  bool hardware_decoding_ = false;
   bool is_video_ = false;
   std::vector<EquirectImage> eyes_;          // the still, or the video frame shown: mono, or left and right
   std::unique_ptr<PanoramaVideo> video_;     // open while the view is here

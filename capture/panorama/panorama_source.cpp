@@ -78,7 +78,7 @@ PanoramaSource::PanoramaSource(const SourceConfig& config, bool carries_light) :
   const PanoramaConfig& panorama = config.panorama;
   // Each place opens its video to check it; only the first, in view, keeps its decoder.
   for (size_t k = 0; k < panorama.viewpoint_count(); ++k) {
-    impl_->places.emplace_back(panorama.viewpoint(k), panorama.layout, carries_light);
+    impl_->places.emplace_back(panorama.viewpoint(k), panorama.layout, carries_light, panorama.hardware_decoding);
     if (k > 0) impl_->places.back().leave();
   }
   // Every viewpoint mono, or every one stereo: the frames of a time step are one or two throughout.

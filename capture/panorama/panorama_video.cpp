@@ -106,6 +106,29 @@ struct PanoramaVideo::Impl {
     return std::nullopt;
   }
 
+  // The board's V4L2 memory-to-memory decoder for the codec (h264_v4l2m2m, hevc_v4l2m2m,
+  // vp8_v4l2m2m, vp9_v4l2m2m: the Raspberry Pi's, Rockchip's, i.MX's), when FFmpeg has one and it
+  // opens (a device that decodes the codec exists); codec stays null otherwise.
+  void open_hardware_decoder(const AVCodecParameters* parameters) {
+    const std::string name = fmt::format("{}_v4l2m2m", avcodec_get_name(parameters->codec_id));
+    const AVCodec* hardware = avcodec_find_decoder_by_name(name.c_str());
+    if (!hardware) {
+      log::debug("panorama video \"{}\": no {} decoder in FFmpeg: software decoding", file.string(), name);
+      return;
+    }
+    AVCodecContext* context = avcodec_alloc_context3(hardware);
+    int error = context ? avcodec_parameters_to_context(context, parameters) : AVERROR(ENOMEM);
+    if (error >= 0) error = avcodec_open2(context, hardware, nullptr);
+    if (error < 0) {
+      avcodec_free_context(&context);
+      log::info("panorama video \"{}\": no hardware decoder ({}: {}): software decoding", file.string(), name,
+                ffmpeg_error(error));
+      return;
+    }
+    log::info("panorama video \"{}\": decoded by {}", file.string(), name);
+    codec = context;
+  }
+
   int64_t index_of(int64_t pts) const {
     // (pts - start) x time_base x rate, rounded to the nearest frame.
     return av_rescale_q_rnd(pts - start_pts, time_base, av_inv_q(rate),
@@ -129,7 +152,8 @@ struct PanoramaVideo::Impl {
   }
 };
 
-PanoramaVideo::PanoramaVideo(const std::filesystem::path& file, PanoramaLayout layout) : impl_(std::make_unique<Impl>()) {
+PanoramaVideo::PanoramaVideo(const std::filesystem::path& file, PanoramaLayout layout, bool hardware)
+    : impl_(std::make_unique<Impl>()) {
   Impl& s = *impl_;
   s.file = file;
   std::error_code ec;
@@ -160,10 +184,14 @@ PanoramaVideo::PanoramaVideo(const std::filesystem::path& file, PanoramaLayout l
     s.fail(fmt::format("not a panorama: {}", why));
   s.width = width;
   s.height = height;
-  s.codec = avcodec_alloc_context3(decoder);
-  if (!s.codec || avcodec_parameters_to_context(s.codec, parameters) < 0) s.fail("cannot set up its decoder");
-  s.codec->thread_count = 0;  // FFmpeg's choice: one per core
-  if ((error = avcodec_open2(s.codec, decoder, nullptr)) < 0) s.fail(fmt::format("cannot open its {} decoder: {}", decoder->name, ffmpeg_error(error)));
+  if (hardware) s.open_hardware_decoder(parameters);
+  if (!s.codec) {  // software
+    s.codec = avcodec_alloc_context3(decoder);
+    if (!s.codec || avcodec_parameters_to_context(s.codec, parameters) < 0) s.fail("cannot set up its decoder");
+    s.codec->thread_count = 0;  // FFmpeg's choice: one per core
+    if ((error = avcodec_open2(s.codec, decoder, nullptr)) < 0)
+      s.fail(fmt::format("cannot open its {} decoder: {}", decoder->name, ffmpeg_error(error)));
+  }
   s.time_base = stream->time_base;
   s.rate = stream->avg_frame_rate.num > 0 && stream->avg_frame_rate.den > 0 ? stream->avg_frame_rate : stream->r_frame_rate;
   if (s.rate.num <= 0 || s.rate.den <= 0 || s.time_base.num <= 0 || s.time_base.den <= 0) s.fail("no frame rate or time base");

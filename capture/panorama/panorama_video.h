@@ -1,7 +1,8 @@
 // A 360° video read frame by frame through FFmpeg's libraries (libavformat, libavcodec, libswscale),
 // each frame with its index in presentation order: (pts - the stream's start) x the nominal frame
 // rate, rounded, so B-frames (decoded out of order), an MP4 edit list (which moves the start) and
-// seeking all give the frame its own index. Software decoding with FFmpeg's frame threads.
+// seeking all give the frame its own index. Software decoding with FFmpeg's frame threads, or the
+// board's V4L2 memory-to-memory decoder where it has one.
 //
 // A hostile file is contained where FFmpeg allows it: only the file protocol, the MP4/MOV and
 // Matroska/WebM demuxers and the H.264, HEVC, VP8, VP9 and AV1 decoders are allowed, and the size
@@ -32,7 +33,10 @@ class PanoramaVideo {
   // cannot open or decode, a codec or container outside the list above, or a shape that is not a panorama.
   // layout: how each frame holds the sphere (a stereo pair: both eyes); the file's stereo metadata,
   // where it has some, must say the same. Auto: what the metadata says, else what the shape holds.
-  explicit PanoramaVideo(const std::filesystem::path& file, PanoramaLayout layout = PanoramaLayout::Auto);
+  // hardware: try the board's V4L2 memory-to-memory decoder for the codec first (FFmpeg's
+  // <codec>_v4l2m2m), software when there is none; describe() names the decoder used.
+  explicit PanoramaVideo(const std::filesystem::path& file, PanoramaLayout layout = PanoramaLayout::Auto,
+                         bool hardware = false);
   ~PanoramaVideo();
   PanoramaVideo(const PanoramaVideo&) = delete;
   PanoramaVideo& operator=(const PanoramaVideo&) = delete;

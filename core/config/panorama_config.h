@@ -117,6 +117,8 @@ struct PanoramaConfig {
   double ipd_m = 0.064;
   double pole_merge_from_rad = 60 * std::numbers::pi / 180;
   double pole_merge_to_rad = 75 * std::numbers::pi / 180;
+  // Videos: the board's V4L2 memory-to-memory decoder first, where it has one (software otherwise).
+  bool hardware_decoding = true;
   PanoramaViewConfig view;
   // Viewpoints 1, 2, ... (this table's own file, position and yaw are viewpoint 0).
   std::vector<PanoramaViewpoint> viewpoints;
@@ -146,6 +148,9 @@ void visit(V& v, PanoramaConfig& s) {
         "stereo layouts: the elevation up to which the capture kept the eyes ipd_m apart");
   v.key("pole_merge_to_deg", s.pole_merge_to_rad, Degrees{NumberRange::closed(0, 90)},
         "stereo layouts: the elevation from which it had brought them together (a raised-cosine fall between)");
+  v.key("hardware_decoding", s.hardware_decoding,
+        "videos: decode with the board's V4L2 memory-to-memory decoder (FFmpeg's <codec>_v4l2m2m) where it has one, "
+        "software otherwise");
   v.section("view", s.view, "the camera that looks at the panorama");
   v.sections("viewpoints", s.viewpoints, "more places, each its own panorama: [[source.panorama.viewpoints]], visited in turn");
 }

@@ -119,6 +119,20 @@ TEST(PanoramaVideo, WebmVp9Too) {
   EXPECT_EQ(count, 40);
 }
 
+TEST(PanoramaVideo, HardwareDecodingWhereTheBoardHasNoneIsSoftwareDecoding) {
+  // Asked for the board's V4L2 memory-to-memory decoder: on a machine without one (this one), the
+  // software decoder, every frame at its index; on a board with one, the same frames from it.
+  PanoramaVideo video(h264_with_b_frames(), PanoramaLayout::Auto, true);
+  std::printf("decoded by: %s\n", video.describe().c_str());
+  EXPECT_TRUE(video.describe().rfind("h264 ", 0) == 0 || video.describe().rfind("h264_v4l2m2m ", 0) == 0) << video.describe();
+  PanoramaVideoFrame frame;
+  for (int k = 0; k < 64; ++k) {
+    ASSERT_TRUE(video.next(frame)) << k;
+    EXPECT_EQ(frame.index, k);
+    EXPECT_EQ(read_barcode(frame), k);
+  }
+}
+
 TEST(PanoramaVideo, AHundredRandomSeeksLandOnTheirFrame) {
   PanoramaVideo video(h264_with_b_frames());
   std::mt19937 rng(11);
