@@ -91,7 +91,7 @@ std::vector<ObjectReport> OcclusionMeter::measure(const CameraModel& camera, con
         for (int gx = 0; gx < kGrid; ++gx) {
           const double u = u0 + (gx + 0.5) * (u1 - u0) / kGrid, v = v0 + (gy + 0.5) * (v1 - v0) / kGrid;
           const Vec3 dir = T_world_cam.rotate(Vec3{(u - cx) / fx, (v - cy) / fy, 1.0});
-          const Vec3 from = origin + ods_eye_origin(rig, eye, Vec3{0, 0, 1}, normalized(dir));
+          const Vec3 from = eye == Eye::Mono ? origin : origin + ods_eye_origin(rig, eye, Vec3{0, 0, 1}, normalized(dir));
           const std::optional<float> t_object = placed.hit_distance(from, dir);
           if (!t_object) continue;
           ++met;

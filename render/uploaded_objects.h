@@ -20,8 +20,7 @@ namespace arpipe {
 // Proxies under a stereo panorama are cut into triangles no longer than this (mesh_subdivide.h):
 // each eye's offset bends a straight edge, which the rasteriser would draw straight between its
 // projected ends (tests/render/panorama_stereo_test.cpp measures an edge 0.9 m away: 0.31 px
-// mean error cut, 1.8 px uncut in 0.3 m pieces); and at most this many triangles each (the edge
-// grows instead).
+// mean error cut); and at most this many triangles each (the edge grows instead).
 inline constexpr double kOdsMaxEdgeM = 0.1;
 inline constexpr size_t kMaxStereoProxyTriangles = 1'000'000;
 

@@ -34,38 +34,41 @@ struct SimulateOptions {
   std::string video;       // also the frames as this 360° MP4 (a LENSMODEL_LONLAT camera's)
 };
 
-// The recording in `dir` as a 360° H.264 MP4 at the scene's frame rate, with the spherical
-// metadata of its layout: what source.panorama.file reads as a video.
-void write_frames_as_video(const std::filesystem::path& dir, const std::filesystem::path& file, const sim::SimCamera& camera) {
+// Each frame of the recording in `dir`, in order, as packed RGB24 of its size.
+template <class Use>
+void for_each_rgb_frame(const std::filesystem::path& dir, Use use) {
   const RecordingReader reader(dir);
-  const PanoramaLayout layout = !camera.stereo.enabled ? PanoramaLayout::Equirect
-                                : camera.stereo.top_bottom ? PanoramaLayout::EquirectTopBottom
-                                                           : PanoramaLayout::EquirectLeftRight;
-  PanoramaVideoWriter writer(file, camera.frame_width(), camera.frame_height(), camera.fps, layout);
   Frame frame;
   std::vector<uint8_t> rgb;
   for (size_t i = 0; i < reader.frame_count(); ++i) {
     reader.read(i, frame);
     to_rgb24(frame, rgb);
-    writer.write(rgb.data(), size_t(frame.width) * 3);
+    use(i, rgb, frame.width, frame.height);
   }
+}
+
+// The recording in `dir` as a 360° H.264 MP4 at the scene's frame rate, with the spherical
+// metadata of its layout: what source.panorama.file reads as a video.
+void write_frames_as_video(const std::filesystem::path& dir, const std::filesystem::path& file, const sim::SimCamera& camera) {
+  const PanoramaLayout layout = !camera.stereo.enabled ? PanoramaLayout::Equirect
+                                : camera.stereo.top_bottom ? PanoramaLayout::EquirectTopBottom
+                                                           : PanoramaLayout::EquirectLeftRight;
+  PanoramaVideoWriter writer(file, camera.frame_width(), camera.frame_height(), camera.fps, layout);
+  for_each_rgb_frame(dir, [&](size_t, const std::vector<uint8_t>& rgb, int width, int) {
+    writer.write(rgb.data(), size_t(width) * 3);
+  });
   writer.finish();
 }
 
 // Each frame of the recording in `dir` as dir/frame_NNNNNN.png (8-bit RGB): a still for
 // source.panorama.file when the camera is an equirectangular LENSMODEL_LONLAT, or a picture to look at.
 void write_frames_as_png(const std::filesystem::path& dir) {
-  const RecordingReader reader(dir);
-  Frame frame;
-  std::vector<uint8_t> rgb;
-  for (size_t i = 0; i < reader.frame_count(); ++i) {
-    reader.read(i, frame);
-    to_rgb24(frame, rgb);
-    const std::vector<uint8_t> png = encode_png(from_rgb24(rgb.data(), frame.width, frame.height, PixelFormat::RGB24));
+  for_each_rgb_frame(dir, [&](size_t i, const std::vector<uint8_t>& rgb, int width, int height) {
+    const std::vector<uint8_t> png = encode_png(from_rgb24(rgb.data(), width, height, PixelFormat::RGB24));
     const std::filesystem::path file = dir / fmt::format("frame_{:06d}.png", i);  // as the PNG sink names them
     if (const int error = replace_file(file, png))
       throw std::runtime_error(fmt::format("{}: {}", file.string(), std::strerror(error)));
-  }
+  });
 }
 
 int run_simulate(SimulateOptions& command) {

@@ -9,6 +9,7 @@
 
 #include "capture/image_file.h"
 #include "capture/panorama/panorama_file_kind.h"
+#include "capture/panorama/stereo_eye_pixels.h"
 #include "core/image/hdr_file.h"
 #include "core/image/srgb.h"
 #include "core/scene/asset_error.h"
@@ -84,15 +85,9 @@ std::vector<EquirectImage> EquirectImage::split(std::vector<uint8_t> rgb, int wi
   }
   const bool top_bottom = layout == PanoramaLayout::EquirectTopBottom;
   const int eye_width = top_bottom ? width : width / 2, eye_height = top_bottom ? height / 2 : height;
-  const size_t eye_row = size_t(eye_width) * 3, row = size_t(width) * 3;
-  for (int eye = 0; eye < 2; ++eye) {
-    std::vector<uint8_t> pixels(eye_row * size_t(eye_height));
-    for (int y = 0; y < eye_height; ++y) {
-      const size_t from = top_bottom ? size_t(eye * eye_height + y) * row : size_t(y) * row + size_t(eye) * eye_row;
-      std::copy_n(rgb.data() + from, eye_row, pixels.data() + size_t(y) * eye_row);
-    }
-    eyes.emplace_back(std::move(pixels), eye_width, eye_height, fmt::format("{} ({} eye)", name, eye == 0 ? "left" : "right"));
-  }
+  for (int eye = 0; eye < 2; ++eye)
+    eyes.emplace_back(stereo_eye_pixels(rgb, width, height, top_bottom, eye), eye_width, eye_height,
+                      fmt::format("{} ({} eye)", name, eye == 0 ? "left" : "right"));
   return eyes;
 }
 

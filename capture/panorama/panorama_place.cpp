@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "capture/panorama/panorama_file_kind.h"
+#include "capture/panorama/stereo_eye_pixels.h"
 #include "core/environment/hdr_environment.h"
 #include "core/image/hdr_file.h"
 #include "core/scene/asset_error.h"
@@ -16,17 +17,16 @@ namespace {
 // A video frame's light: each block's mean from 4 x 4 of its texels (a still's from every texel).
 constexpr int kVideoLightTaps = 4;
 
-// A stereo pair's left eye (the whole image for a mono layout), whose shape the loader checked.
-HdrImage left_eye(HdrImage whole) {
-  if (whole.width == 2 * whole.height) return whole;  // mono (the loader checked the layout's shape)
+// A stereo pair's left eye (the whole image for a mono layout), whose shape the loader checked
+// against the layout ("auto": told by the shape).
+HdrImage left_eye(HdrImage whole, PanoramaLayout layout) {
+  if (layout == PanoramaLayout::Auto) layout = layout_of_shape(whole.width, whole.height);
+  if (layout == PanoramaLayout::Equirect) return whole;
+  const bool top_bottom = layout == PanoramaLayout::EquirectTopBottom;
   HdrImage eye;
-  const bool left_right = whole.width == 4 * whole.height;
-  eye.width = left_right ? whole.width / 2 : whole.width;
-  eye.height = left_right ? whole.height : whole.height / 2;
-  eye.rgb.resize(size_t(eye.width) * size_t(eye.height) * 3);
-  for (int y = 0; y < eye.height; ++y)
-    std::copy_n(whole.rgb.data() + size_t(y) * size_t(whole.width) * 3, size_t(eye.width) * 3,
-                eye.rgb.data() + size_t(y) * size_t(eye.width) * 3);
+  eye.width = top_bottom ? whole.width : whole.width / 2;
+  eye.height = top_bottom ? whole.height / 2 : whole.height;
+  eye.rgb = stereo_eye_pixels(whole.rgb, whole.width, whole.height, top_bottom, 0);
   return eye;
 }
 
@@ -52,7 +52,7 @@ PanoramaPlace::PanoramaPlace(const PanoramaViewpoint& viewpoint, PanoramaLayout 
     const EquirectImage& left = eyes_.front();
     const PanoramaLight light(left.width(), left.height(), R_world_pano);
     light_sh_ = panorama_file_kind(viewpoint.file) == PanoramaFileKind::Hdr
-                    ? light.project(left_eye(read_hdr_image(viewpoint.file)), viewpoint.hdr_scale)
+                    ? light.project(left_eye(read_hdr_image(viewpoint.file), layout), viewpoint.hdr_scale)
                     : light.project(left);
   }
 }

@@ -33,9 +33,10 @@ double ods_eye_radius(const OdsRig& rig, double elevation_rad) {
 
 Vec3 ods_eye_origin(const OdsRig& rig, Eye eye, const Vec3& up, const Vec3& d) {
   const double sign = eye_sign(eye);
+  if (sign == 0) return {0, 0, 0};
   const Vec3 side = cross(up, d);  // horizontal, left of d, |d_h| long
   const double length = norm(side);
-  if (sign == 0 || !(length > 1e-12)) return {0, 0, 0};
+  if (!(length > 1e-12)) return {0, 0, 0};
   const double elevation = std::atan2(dot(d, up), length);
   return (sign * ods_eye_radius(rig, elevation) / length) * side;
 }

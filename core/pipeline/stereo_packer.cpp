@@ -27,6 +27,18 @@ Frame pack_stereo_pair(const Frame& left, const Frame& right, StereoOutput packi
   return pair;
 }
 
+std::shared_ptr<const CameraModel> StereoPacker::lens_over_pair(const std::shared_ptr<const CameraModel>& eye,
+                                                                const Frame& pair) {
+  if (!eye || pair.empty()) return eye;
+  // The same eye lens and pair size every frame: made once.
+  for (const PairLens& known : lenses_)
+    if (known.eye == eye && known.over->width() == pair.width && known.over->height() == pair.height) return known.over;
+  PairLens made{eye, std::make_shared<const CameraModel>(eye->lensmodel(), eye->intrinsics(), pair.width, pair.height)};
+  if (lenses_.size() >= 4) lenses_.erase(lenses_.begin());
+  lenses_.push_back(made);
+  return made.over;
+}
+
 std::optional<FrameContext> StereoPacker::add(FrameContext ctx) {
   const Eye eye = ctx.camera.meta.eye;
   if (eye == Eye::Mono || eye == Eye::Pair) return ctx;
@@ -44,18 +56,12 @@ std::optional<FrameContext> StereoPacker::add(FrameContext ctx) {
   }
   FrameContext pair = std::move(*left_);
   left_.reset();
-  // The pictures' lens: the left eye's over the whole pair (exact for the left half, which starts
-  // at the top left corner), so that a recording of the pairs carries a model of their size.
-  const auto over_pair = [](const std::shared_ptr<const CameraModel>& eye, const Frame& pair) -> std::shared_ptr<const CameraModel> {
-    if (!eye || pair.empty()) return eye;
-    return std::make_shared<const CameraModel>(eye->lensmodel(), eye->intrinsics(), pair.width, pair.height);
-  };
   pair.output = pack_stereo_pair(pair.output, ctx.output, packing_);
   pair.output.meta.eye = Eye::Pair;
-  pair.output_camera_model = over_pair(pair.output_camera_model ? pair.output_camera_model : pair.camera_model, pair.output);
+  pair.output_camera_model = lens_over_pair(pair.output_camera_model ? pair.output_camera_model : pair.camera_model, pair.output);
   if (Frame camera = pack_stereo_pair(pair.camera, ctx.camera, packing_); !camera.empty()) {
     pair.camera = std::move(camera);
-    pair.camera_model = over_pair(pair.camera_model, pair.camera);
+    pair.camera_model = lens_over_pair(pair.camera_model, pair.camera);
   }
   pair.camera.meta.eye = Eye::Pair;
   for (StageTiming& timing : ctx.timings) {

@@ -5,7 +5,9 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
+#include <vector>
 
 #include "core/config/panorama_config.h"
 #include "core/pipeline/frame_context.h"
@@ -26,6 +28,14 @@ class StereoPacker {
   uint64_t unpaired() const { return unpaired_; }
 
  private:
+  // The pictures' lens: the eye's over the whole pair (exact for the left half, which starts at
+  // the top left corner), so that a recording of the pairs carries a model of their size.
+  std::shared_ptr<const CameraModel> lens_over_pair(const std::shared_ptr<const CameraModel>& eye, const Frame& pair);
+  struct PairLens {
+    std::shared_ptr<const CameraModel> eye, over;
+  };
+  std::vector<PairLens> lenses_;  // the few made so far (the output's and the camera's)
+
   StereoOutput packing_;
   std::optional<FrameContext> left_;
   uint64_t unpaired_ = 0;
