@@ -241,6 +241,18 @@ std::unique_ptr<SinkWorker> PipelineRunner::make_worker(std::string key, std::un
                                       source_->is_live() ? OverflowPolicy::DropOldest : OverflowPolicy::Block);
 }
 
+namespace {
+
+// A live run's sink that fell behind lost its oldest frames; the last word on it says how many,
+// so that its output can be reconciled with the frames out.
+void log_sink_drops(const SinkWorker& worker) {
+  const SinkStats stats = worker.stats();
+  if (stats.dropped > 0)
+    log::warn("{}: took {} frames, dropped {} it fell behind on", stats.key, stats.consumed, stats.dropped);
+}
+
+}  // namespace
+
 void PipelineRunner::sink_loop() {
   // Each sink's thread tells it the run is up before its first frame: the stages are configured
   // and every sink exists, so the outputs of an earlier run may now be replaced.
@@ -273,7 +285,10 @@ void PipelineRunner::sink_loop() {
   if (stereo_packer_ && stereo_packer_->unpaired() > 0)
     log::warn("stereo output: {} eye frames came without their other eye and were not shown", stereo_packer_->unpaired());
   // Every sink takes what is queued for it and flushes.
-  for (auto& worker : sinks_) worker->finish();
+  for (auto& worker : sinks_) {
+    worker->finish();
+    log_sink_drops(*worker);
+  }
   finished_ = true;
 }
 
@@ -292,6 +307,7 @@ void PipelineRunner::swap_sinks(SinkSwap& swap) {
       // Everything it was handed is written and durable, and its output closed, before a new
       // sink may take over the same path.
       running->finish();
+      log_sink_drops(*running);
       const std::string closed = running->describe();
       running.reset();
       log::info("{}: closed {}", key, closed);

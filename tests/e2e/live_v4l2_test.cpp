@@ -85,7 +85,15 @@ TEST_F(LiveV4L2, DaemonRunsThroughFaultsOnALiveCamera) {
   EXPECT_EQ(number_after(metrics_line, "info: "), 30) << metrics_line;
   EXPECT_EQ(number_after(metrics_line, " frames in, ") + number_after(metrics_line, "queue drops "), 30)
       << "frames out + queue drops";
-  EXPECT_EQ(result_lines(), size_t(number_after(metrics_line, " frames in, ")));
+  // Every frame out is a results line, or one the results sink dropped when it fell behind (a
+  // slow machine): the daemon's last word on that sink says how many.
+  const size_t sink_drops = err.find("sinks.results: took ");
+  const int64_t results_dropped =
+      sink_drops == std::string::npos ? 0 : number_after(err, " dropped ", sink_drops);
+  EXPECT_EQ(int64_t(result_lines()) + results_dropped, number_after(metrics_line, " frames in, ")) << err;
+  if (sink_drops != std::string::npos) {
+    EXPECT_EQ(number_after(err, "sinks.results: took ", sink_drops), int64_t(result_lines())) << err;
+  }
   EXPECT_EQ(number_after(camera_line, "sequence gaps "), 2) << "the driver's drop fault";
   EXPECT_GE(number_after(camera_line, "timeouts "), 1) << "the 400 ms stall against a 300 ms timeout";
   EXPECT_EQ(number_after(camera_line, "EAGAIN "), 20) << "the EAGAIN storm";
