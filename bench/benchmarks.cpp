@@ -21,6 +21,7 @@ void add_benchmarks(CLI::App& bench) {
   add_physics_benchmark(bench);
   add_proxies_benchmark(bench);
   add_panorama_benchmark(bench);
+  add_hybrid_benchmark(bench);
 }
 
 }  // namespace arpipe

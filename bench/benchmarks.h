@@ -26,6 +26,7 @@ void add_sh_benchmark(CLI::App& bench);             // sh: spherical-harmonic er
 void add_prt_benchmark(CLI::App& bench);            // prt: PRT bake time against error, run-time cost (prt_bake_accuracy.cpp)
 void add_physics_benchmark(CLI::App& bench);        // physics: time per frame against bounce error, per substep rate (physics_cost.cpp)
 void add_proxies_benchmark(CLI::App& bench);        // proxies: render time against occlusion edge error, full and simplified (proxies_cost.cpp)
-void add_panorama_benchmark(CLI::App& bench);       // panorama: the 360° background's lookup, time against error (panorama_lookup.cpp)
+void add_panorama_benchmark(CLI::App& bench);
+void add_hybrid_benchmark(CLI::App& bench);         // hybrid: seed 003's protocol, the hybrid against the full 3D scene (hybrid_speedup.cpp)       // panorama: the 360° background's lookup, time against error (panorama_lookup.cpp)
 
 }  // namespace arpipe

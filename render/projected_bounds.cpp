@@ -17,26 +17,28 @@ constexpr int kSamplesPerEdge = 16;
 
 }  // namespace
 
+void append_segment_in_front(std::vector<Vec3>& points_cam, const Vec3& a, const Vec3& b, int samples) {
+  // Just in front of the near plane, so that the projection stays finite.
+  const double near = kNearPlaneM * (1 + 1e-9);
+  const bool a_in = a[2] > near, b_in = b[2] > near;
+  if (!a_in && !b_in) return;
+  Vec3 from = a, to = b;
+  if (!a_in) from = a + ((near - a[2]) / (b[2] - a[2])) * (b - a);
+  if (!b_in) to = b + ((near - b[2]) / (a[2] - b[2])) * (a - b);
+  for (int s = 0; s <= samples; ++s) points_cam.push_back(from + (double(s) / samples) * (to - from));
+}
+
 std::optional<PixelRect> projected_box_rect(const CameraModel& camera, const SE3& T_cam_object, const Bounds& box,
                                             double margin_px) {
   std::array<Vec3, 8> corners = box_corners(box);
-  int behind = 0;
-  for (Vec3& corner : corners) {
-    corner = T_cam_object * corner;
-    if (corner[2] <= kNearPlaneM) ++behind;
-  }
-  if (behind == 8) return std::nullopt;
-  const PixelRect image = PixelRect::full(camera.width(), camera.height());
-  if (behind > 0) return image;
-
+  for (Vec3& corner : corners) corner = T_cam_object * corner;
   std::vector<Vec3> points;
   points.reserve(12 * (kSamplesPerEdge + 1));
   for (int a = 0; a < 8; ++a)
     for (int bit = 1; bit < 8; bit <<= 1) {
       if (a & bit) continue;  // each edge once, from the corner with the bit clear
-      const Vec3& from = corners[static_cast<size_t>(a)];
-      const Vec3& to = corners[static_cast<size_t>(a | bit)];
-      for (int s = 0; s <= kSamplesPerEdge; ++s) points.push_back(from + (double(s) / kSamplesPerEdge) * (to - from));
+      append_segment_in_front(points, corners[static_cast<size_t>(a)], corners[static_cast<size_t>(a | bit)],
+                              kSamplesPerEdge);
     }
   return projected_points_rect(camera, points, margin_px);
 }

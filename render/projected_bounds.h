@@ -14,10 +14,16 @@ namespace arpipe {
 
 // box: in the object's frame (already scaled); T_cam_object maps it into the camera frame.
 // Returns the bounding rectangle of the projected box, widened by margin_px and clipped to the
-// image; the whole image when the box reaches behind the near plane (its projection is unbounded);
-// nullopt when it lies wholly behind the near plane or outside the image.
+// image; of its part in front of the near plane when it reaches behind it (as GL clips it: an
+// object beside the camera covers only the image's edge, not all of it); nullopt when it lies
+// wholly behind the near plane or outside the image.
 std::optional<PixelRect> projected_box_rect(const CameraModel& camera, const SE3& T_cam_object, const Bounds& box,
                                             double margin_px);
+
+// Appends samples + 1 points along the segment a-b (camera frame), cut to its part in front of the
+// near plane (none when all of it is behind). The edges of a convex shape so cut, projected, bound
+// the projection of its visible part.
+void append_segment_in_front(std::vector<Vec3>& points_cam, const Vec3& a, const Vec3& b, int samples);
 
 // The same for any set of camera-frame points (a shape's edges, sampled densely enough for the
 // lens's bend): their bounding rectangle, widened, clipped; the whole image when some lie behind

@@ -363,27 +363,29 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
   bool shadow_redrawn = false;
   request.lighting.shadow = shadow_for(ctx, request.lighting, angular_diameter_rad, request.objects, shadow_redrawn);
   if (request.lighting.shadow) {
-    // Proxies that catch the shadow join the footprint (their whole box: the shadow's place on
-    // them is not known here), and so does the ground catcher's patch.
-    if (!proxy_receivers.empty()) {
-      // Only where the objects' shadows can reach them.
-      const std::vector<SE3> seen_from{instants.front().T_cam_world, instants[instants.size() / 2].T_cam_world,
-                                       instants.back().T_cam_world};
-      PixelRect shadows;
-      for (const SE3& T_cam_world : seen_from) {
-        // (Not bounded through an eye's offsets: then the receivers whole.)
-        const std::optional<PixelRect> r =
-            eye == Eye::Mono ? shadow_volume_rect(image_camera, T_cam_world, request.lighting) : std::nullopt;
-        // Unbounded (a grazing light): every receiving proxy in view, whole.
-        shadows = shadows.united(r ? *r : PixelRect::full(camera.width(), camera.height()));
-      }
-      rect = rect.united(proxy_receivers.intersected(shadows));
+    // Where the objects' shadows (and the sky they hide) can fall: the receivers join the
+    // footprint only there. The ground catcher's patch spans every object's shadow, so with
+    // objects all around the camera it would cover the picture; a proxy's box can be a whole
+    // courtyard.
+    const std::vector<SE3> seen_from{instants.front().T_cam_world, instants[instants.size() / 2].T_cam_world,
+                                     instants.back().T_cam_world};
+    PixelRect shadows;
+    for (const SE3& T_cam_world : seen_from) {
+      // (Not bounded through an eye's offsets: then the receivers whole.)
+      const std::optional<PixelRect> r =
+          eye == Eye::Mono ? shadow_volume_rect(image_camera, T_cam_world, request.lighting) : std::nullopt;
+      // Unbounded (a grazing light): every receiver in view, whole.
+      shadows = shadows.united(r ? *r : PixelRect::full(camera.width(), camera.height()));
     }
+    rect = rect.united(proxy_receivers.intersected(shadows));
+    // The sky occlusion darkens the ground catcher's whole patch (faded at its edge).
+    const PixelRect ground_reach =
+        settings_.shadows.sky_occlusion ? PixelRect::full(camera.width(), camera.height()) : shadows;
     const UploadedObject& catcher = *request.objects.back();
     for (const SE3& T_cam_world : exposure_poses)
       if (std::optional<PixelRect> r =
               projected_box_rect(image_camera, T_cam_world * catcher.T_world_object, drawn_box(catcher.bounds), kRectMarginPx))
-        rect = rect.united(*r);
+        rect = rect.united(r->intersected(ground_reach));
   }
   if (settings_.full_canvas) rect = PixelRect::full(camera.width(), camera.height());
   request.rect = warp ? warp->canvas_rect_for(rect) : rect;
@@ -521,6 +523,7 @@ const ShadowLookup* RenderStage::shadow_for(FrameContext& ctx, Lighting& lightin
       lighting.sky_occluders.push_back({static_cast<float>(centre[0]), static_cast<float>(centre[1]),
                                         static_cast<float>(centre[2]), static_cast<float>(object.sky_radius_m)});
     }
+  const double virtual_extent = extent;
   for (const UploadedObject& proxy : proxies_)
     if (proxy.casts_shadows && proxy_at_viewpoint(proxy, ctx.camera.meta.viewpoint)) {
       add_caster(proxy);
@@ -528,7 +531,7 @@ const ShadowLookup* RenderStage::shadow_for(FrameContext& ctx, Lighting& lightin
     }
   // The penumbra of the tallest object, and a little more for the filters' reach.
   const double margin = extent * (std::tan(angular_diameter_rad) + 0.05);
-  const std::optional<ShadowFrustum> frustum =
+  std::optional<ShadowFrustum> frustum =
       lighting.local
           ? fit_local_shadow_frustum(lighting.position, casters, settings_.shadows.receiver_height_m, margin)
           : fit_shadow_frustum(shadow_light_direction_, casters, settings_.shadows.receiver_height_m, margin);
@@ -538,10 +541,48 @@ const ShadowLookup* RenderStage::shadow_for(FrameContext& ctx, Lighting& lightin
   ReceiverPatch patch = frustum->receiver;
   if (!real_casters.empty()) {
     const std::vector<ShadowCaster> virtual_casters(casters.begin(), casters.end() - long(real_casters.size()));
+    // Widened by the virtual objects' own penumbra: a large real caster (a whole courtyard) must
+    // not spread the catcher, and with it the footprint, over the picture.
+    const double virtual_margin = virtual_extent * (std::tan(angular_diameter_rad) + 0.05);
     const std::optional<ShadowFrustum> virtual_only =
-        lighting.local ? fit_local_shadow_frustum(lighting.position, virtual_casters, settings_.shadows.receiver_height_m, margin)
-                       : fit_shadow_frustum(shadow_light_direction_, virtual_casters, settings_.shadows.receiver_height_m, margin);
-    if (virtual_only) patch = virtual_only->receiver;
+        lighting.local
+            ? fit_local_shadow_frustum(lighting.position, virtual_casters, settings_.shadows.receiver_height_m, virtual_margin)
+            : fit_shadow_frustum(shadow_light_direction_, virtual_casters, settings_.shadows.receiver_height_m, virtual_margin);
+    if (virtual_only) {
+      patch = virtual_only->receiver;
+      // The maps are read only on the virtual objects and where their shadows fall: the column of
+      // light over those, across. Along the light they still span every caster, so that a real
+      // one anywhere up the column shades them. A courtyard of proxies would otherwise spread the
+      // map's texels, and with them the shadow filters' reach, over the whole courtyard.
+      // Along it, only as far as the proxies reach into the column (each proxy's clusters,
+      // so that a courtyard's floor adds its patch under the column, not its whole extent): the
+      // PCSS blocker search widens with the depth range.
+      if (!lighting.local) {
+        ShadowFrustum narrowed = *virtual_only;
+        for (const UploadedObject& object : proxies_) {
+          // The receivers too: one beyond the far end would read as lit.
+          if (!(object.casts_shadows || object.shadow_catcher) || !proxy_at_viewpoint(object, ctx.camera.meta.viewpoint))
+            continue;
+          const UploadedObject* proxy = &object;
+          const std::vector<Bounds> whole{proxy->bounds};
+          for (const Bounds& cluster : proxy->cluster_bounds.empty() ? whole : proxy->cluster_bounds) {
+            Bounds world{{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
+            for (const Vec3& corner : box_corners(cluster)) {
+              const Vec3 w = proxy->T_world_object * corner;
+              for (size_t k = 0; k < 3; ++k) {
+                world.min[k] = std::min(world.min[k], w[k]);
+                world.max[k] = std::max(world.max[k], w[k]);
+              }
+            }
+            extend_depth_over(narrowed, world);
+          }
+        }
+        const double slack = 1e-3 * std::max(narrowed.max[2] - narrowed.min[2], 1e-3);
+        narrowed.min[2] -= slack;
+        narrowed.max[2] += slack;
+        frustum = narrowed;
+      }
+    }
   }
   // The sky occlusion reaches further than the shadow: a sphere of radius r whose centre stands c
   // above the ground hides r^2 c / d^3 of its sky at distance d (1 % at d = 4 r). Growing the patch
@@ -566,8 +607,8 @@ const ShadowLookup* RenderStage::shadow_for(FrameContext& ctx, Lighting& lightin
     lighting.real_shadow = &real_shadow_pass_->lookup();
   }
   drawn.push_back(&catcher);
-  lighting.unshadowed = unshadowed_objects(caster_objects, *frustum, settings_.shadow_method,
-                                           shadow_lookup_reach_m(shadow_pass_->lookup(), *frustum));
+  shadow_filter_reach_m_ = shadow_lookup_reach_m(shadow_pass_->lookup(), *frustum);
+  lighting.unshadowed = unshadowed_objects(caster_objects, *frustum, settings_.shadow_method, shadow_filter_reach_m_);
   redrawn = drew;
   if (drew) glFinish();  // honest timings: the work is queued until something waits
   ctx.record_timing("shadow", milliseconds_since(start), drew ? "" : "reused");
@@ -603,36 +644,70 @@ bool RenderStage::move_objects(const ShutterMotion& motion) {
 std::optional<PixelRect> RenderStage::shadow_volume_rect(const CameraModel& camera, const SE3& T_cam_world,
                                                         const Lighting& lighting) const {
   // Each object's shadow lies in the hull of its box and the box's projection onto the ground
-  // along the light: their edges and the segments joining them, sampled for the lens's bend, with
-  // the ground copy also shifted by the penumbra's reach.
+  // along the light (the sweep), and the shadow lookups near it read it from up to the filter's
+  // reach away: the sweep grown by a square that holds that reach. With sky occlusion, the
+  // square of the ground it darkens too (render/object_renderer.cpp: 2 r about its centre). Sampled
+  // for the lens's bend, and cut at the near plane, so that an object beside or behind the camera
+  // bounds only the part of its shadow in front of it.
   constexpr int kSamples = 8;
   const double h = settings_.shadows.receiver_height_m;
+  PixelRect rect;
   std::vector<Vec3> points;
   for (const UploadedObject& object : objects_) {
     if (!object.present) continue;
+    points.clear();
     const std::array<Vec3, 8> local = box_corners(object.bounds);
-    std::array<Vec3, 8> top{}, ground{};
-    const double reach = norm(object.bounds.max - object.bounds.min) * 0.1 + 0.01;
+    // The penumbra, or the shadow filter's own reach when the map's texels are coarser (a map
+    // fitted around large real casters).
+    const double reach = std::max(norm(object.bounds.max - object.bounds.min) * 0.1 + 0.01, shadow_filter_reach_m_);
+    std::array<Vec3, 8> corners{}, towards{};
+    double lowest_sin = 1;  // of the light's elevation over the corners
     for (size_t i = 0; i < 8; ++i) {
-      top[i] = object.T_world_object * local[i];
-      const Vec3 towards = lighting.local ? normalized(lighting.position - top[i]) : lighting.direction;
-      if (towards[2] < 0.05) return std::nullopt;  // grazing light: the shadow runs far
-      ground[i] = top[i] - ((top[i][2] - h) / towards[2]) * towards;
+      corners[i] = object.T_world_object * local[i];
+      towards[i] = lighting.local ? normalized(lighting.position - corners[i]) : lighting.direction;
+      if (towards[i][2] < 0.05) return std::nullopt;  // grazing light: the shadow runs far
+      lowest_sin = std::min(lowest_sin, towards[i][2]);
     }
-    const auto add_segment = [&](const Vec3& a, const Vec3& b) {
-      for (int s = 0; s <= kSamples; ++s) points.push_back(T_cam_world * (a + (double(s) / kSamples) * (b - a)));
+    // The reach is across the light, a square window of the map (the diagonal sqrt 2 times as far);
+    // on the ground it stretches by up to 1 / sin of the light's elevation. A square of that
+    // half-width holds the disc it can reach.
+    const double r = std::sqrt(2.0) * reach / lowest_sin;
+    const std::array<Vec3, 4> square{Vec3{r, r, 0}, Vec3{-r, r, 0}, Vec3{-r, -r, 0}, Vec3{r, -r, 0}};
+    // The sweep's 16 vertices: the box's corners (0-7) and their shadows on the ground (8-15), world.
+    std::array<Vec3, 16> sweep{};
+    for (size_t i = 0; i < 8; ++i) {
+      sweep[i] = corners[i];
+      sweep[8 + i] = corners[i] - ((corners[i][2] - h) / towards[i][2]) * towards[i];
+    }
+    // The sum of the sweep and the square: each of the sweep's edges moved to each of the square's
+    // corners, and the square's edges placed at each of the sweep's vertices.
+    const auto edge = [&](const Vec3& a, const Vec3& b) {
+      append_segment_in_front(points, T_cam_world * a, T_cam_world * b, kSamples);
     };
-    for (size_t a = 0; a < 8; ++a) {
-      add_segment(top[a], ground[a]);
-      for (size_t bit = 1; bit < 8; bit <<= 1) {
-        if (a & bit) continue;
-        add_segment(top[a], top[a | bit]);
-        for (const Vec3& shift : {Vec3{reach, 0, 0}, Vec3{-reach, 0, 0}, Vec3{0, reach, 0}, Vec3{0, -reach, 0}})
-          add_segment(ground[a] + shift, ground[a | bit] + shift);
+    for (const Vec3& shift : square)
+      for (size_t a = 0; a < 8; ++a) {
+        edge(sweep[a] + shift, sweep[8 + a] + shift);
+        for (size_t bit = 1; bit < 8; bit <<= 1) {
+          if (a & bit) continue;
+          edge(sweep[a] + shift, sweep[a | bit] + shift);
+          edge(sweep[8 + a] + shift, sweep[8 + (a | bit)] + shift);
+        }
       }
+    for (const Vec3& vertex : sweep)
+      for (size_t k = 0; k < 4; ++k) edge(vertex + square[k], vertex + square[(k + 1) % 4]);
+    if (settings_.shadows.sky_occlusion) {
+      const Vec3 centre = object.T_world_object * (0.5 * (object.bounds.min + object.bounds.max));
+      const double r = 2 * object.sky_radius_m;
+      std::array<Vec3, 4> square{};
+      for (size_t i = 0; i < 4; ++i)
+        square[i] = T_cam_world * Vec3{centre[0] + ((i == 1 || i == 2) ? r : -r), centre[1] + (i >= 2 ? r : -r), h};
+      for (size_t i = 0; i < 4; ++i) append_segment_in_front(points, square[i], square[(i + 1) % 4], kSamples);
     }
+    // Object by object: the hull is convex, their union is not (one beside the camera on the left
+    // and one on the right would span the picture). Behind the camera or out of the picture: none.
+    if (const std::optional<PixelRect> r = projected_points_rect(camera, points, kRectMarginPx)) rect = rect.united(*r);
   }
-  return projected_points_rect(camera, points, kRectMarginPx);
+  return rect;
 }
 
 double RenderStage::moving_objects_motion_px(const ShutterMotion& motion, const CameraModel& camera) const {

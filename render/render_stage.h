@@ -87,7 +87,7 @@ class RenderStage final : public Stage {
   // whether any of them moved since the last frame.
   bool move_objects(const ShutterMotion& motion);
   // Where the objects' shadows can fall in the image (their boxes' shadow volumes down to the
-  // ground); nullopt when it cannot be bounded (a grazing light).
+  // ground); empty when none is in view; nullopt when it cannot be bounded (a grazing light).
   std::optional<PixelRect> shadow_volume_rect(const CameraModel& camera, const SE3& T_cam_world,
                                               const Lighting& lighting) const;
   // The largest image motion of a moving object's box corners over the exposure (its own blur).
@@ -103,6 +103,7 @@ class RenderStage final : public Stage {
   std::unique_ptr<CatcherBake> catcher_bake_;  // made on the first frame with a shadow
   std::unique_ptr<ShadowMapPass> real_shadow_pass_;  // the casting proxies alone (made when there are any)
   Vec3 shadow_light_direction_{0, 0, 0};  // what the shadow map was made for (moves in steps)
+  double shadow_filter_reach_m_ = 0;        // how far from a point this frame's shadow lookups read
   PerModelCache<LensWarpMap> warp_maps_;
   PerModelCache<CameraModel> pinhole_cores_;  // render.lens = "undistort": what the output sees
   std::vector<UploadedObject> objects_;

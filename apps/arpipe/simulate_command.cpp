@@ -11,13 +11,10 @@
 #include "apps/arpipe/commands.h"
 #include "apps/cli/command_line.h"
 #include "apps/cli/progress_bar.h"
-#include "capture/panorama/panorama_video_writer.h"
-#include "capture/recording/recording_reader.h"
+#include "capture/sim/recording_files.h"
 #include "capture/sim/scene_export.h"
 #include "capture/sim/sim_scene_loader.h"
 #include "capture/sinks/output_path.h"
-#include "capture/sinks/png_encoding.h"
-#include "core/image/pixel_convert.h"
 #include "capture/sim/simulator.h"
 #include "core/log.h"
 
@@ -33,43 +30,6 @@ struct SimulateOptions {
   std::string export_glb;  // also the real objects and lights as this .glb
   std::string video;       // also the frames as this 360° MP4 (a LENSMODEL_LONLAT camera's)
 };
-
-// Each frame of the recording in `dir`, in order, as packed RGB24 of its size.
-template <class Use>
-void for_each_rgb_frame(const std::filesystem::path& dir, Use use) {
-  const RecordingReader reader(dir);
-  Frame frame;
-  std::vector<uint8_t> rgb;
-  for (size_t i = 0; i < reader.frame_count(); ++i) {
-    reader.read(i, frame);
-    to_rgb24(frame, rgb);
-    use(i, rgb, frame.width, frame.height);
-  }
-}
-
-// The recording in `dir` as a 360° H.264 MP4 at the scene's frame rate, with the spherical
-// metadata of its layout: what source.panorama.file reads as a video.
-void write_frames_as_video(const std::filesystem::path& dir, const std::filesystem::path& file, const sim::SimCamera& camera) {
-  const PanoramaLayout layout = !camera.stereo.enabled ? PanoramaLayout::Equirect
-                                : camera.stereo.top_bottom ? PanoramaLayout::EquirectTopBottom
-                                                           : PanoramaLayout::EquirectLeftRight;
-  PanoramaVideoWriter writer(file, camera.frame_width(), camera.frame_height(), camera.fps, layout);
-  for_each_rgb_frame(dir, [&](size_t, const std::vector<uint8_t>& rgb, int width, int) {
-    writer.write(rgb.data(), size_t(width) * 3);
-  });
-  writer.finish();
-}
-
-// Each frame of the recording in `dir` as dir/frame_NNNNNN.png (8-bit RGB): a still for
-// source.panorama.file when the camera is an equirectangular LENSMODEL_LONLAT, or a picture to look at.
-void write_frames_as_png(const std::filesystem::path& dir) {
-  for_each_rgb_frame(dir, [&](size_t i, const std::vector<uint8_t>& rgb, int width, int height) {
-    const std::vector<uint8_t> png = encode_png(from_rgb24(rgb.data(), width, height, PixelFormat::RGB24));
-    const std::filesystem::path file = dir / fmt::format("frame_{:06d}.png", i);  // as the PNG sink names them
-    if (const int error = replace_file(file, png))
-      throw std::runtime_error(fmt::format("{}: {}", file.string(), std::strerror(error)));
-  });
-}
 
 int run_simulate(SimulateOptions& command) {
   const std::string& scene_path = command.scene_path;
@@ -116,7 +76,7 @@ int run_simulate(SimulateOptions& command) {
   }
   if (command.png) {
     try {
-      write_frames_as_png(options.out_dir);
+      sim::write_recording_as_pngs(options.out_dir);
     } catch (const std::exception& e) {
       log::error("writing the frames as PNG: {}", e.what());
       return 1;
@@ -124,7 +84,7 @@ int run_simulate(SimulateOptions& command) {
   }
   if (!command.video.empty()) {
     try {
-      write_frames_as_video(options.out_dir, command.video, scene.camera);
+      sim::write_recording_as_video(options.out_dir, command.video, scene.camera);
       log::info("wrote the frames as {}", command.video);
     } catch (const std::exception& e) {
       log::error("writing the frames as a video: {}", e.what());

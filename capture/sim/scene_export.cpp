@@ -32,12 +32,14 @@ Mesh object_frame_mesh(const SimObject& object) {
 
 }  // namespace
 
-Mesh real_world_mesh(const SimScene& scene) {
+Mesh real_world_mesh(const SimScene& scene) { return real_world_mesh(scene, [](const Mesh& mesh) { return mesh; }); }
+
+Mesh real_world_mesh(const SimScene& scene, const std::function<Mesh(const Mesh&)>& per_object) {
   Mesh world;
   world.source = scene.source_file.empty() ? "simulator scene" : scene.source_file.string();
   for (const SimObject& object : scene.objects) {
     if (object.is_virtual) continue;
-    const Mesh mesh = object_frame_mesh(object);
+    const Mesh mesh = per_object(object_frame_mesh(object));
     const uint32_t first_vertex = uint32_t(world.vertex_count());
     const Mat3& R = object.T_world_object.rotation();
     for (size_t v = 0; v < mesh.vertex_count(); ++v) {

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "capture/sim/sim_scene.h"
@@ -18,6 +19,9 @@ namespace arpipe::sim {
 // tessellated (24 rings), meshes at their size and scale. Throws AssetError or
 // std::invalid_argument naming an object that cannot be made.
 Mesh real_world_mesh(const SimScene& scene);
+// The same with each object's mesh, in its own frame, first passed through `per_object` (a
+// simplification for coarser proxies); each object keeps its albedo as one part.
+Mesh real_world_mesh(const SimScene& scene, const std::function<Mesh(const Mesh&)>& per_object);
 
 // The lights: directional ones (the sun among them) with their irradiance (W/m^2) as the
 // intensity; point and sphere lights as points with their radiant intensity (W/sr), a sphere's

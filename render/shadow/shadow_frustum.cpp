@@ -71,6 +71,48 @@ std::array<float, 16> ShadowFrustum::clip_from_world() const {
   return m;
 }
 
+bool extend_depth_over(ShadowFrustum& f, const Bounds& world_box) {
+  const Mat3& R = f.R_light_world;
+  const Vec3 ex{R[0][0], R[0][1], R[0][2]}, ey{R[1][0], R[1][1], R[1][2]}, l{R[2][0], R[2][1], R[2][2]};
+  // In slabs of the box's height (the column leans with the light, so a tall box meets it over
+  // a short stretch of each): each slab's part within the box around the column's cross-sections
+  // at the slab's ends. A corner (x, y) across the light lies at x ex + y ey + t l, t chosen for
+  // the height.
+  constexpr int kSlabs = 8;
+  const int slabs = world_box.max[2] > world_box.min[2] ? kSlabs : 1;
+  bool any = false;
+  for (int s = 0; s < slabs; ++s) {
+    const double z0 = world_box.min[2] + (world_box.max[2] - world_box.min[2]) * s / slabs;
+    const double z1 = world_box.min[2] + (world_box.max[2] - world_box.min[2]) * (s + 1) / slabs;
+    Bounds column{{INFINITY, INFINITY, z0}, {-INFINITY, -INFINITY, z1}};
+    for (const double z : {z0, z1})
+      for (int i = 0; i < 4; ++i) {
+        const double x = (i & 1) ? f.max[0] : f.min[0], y = (i & 2) ? f.max[1] : f.min[1];
+        const double t = (z - x * ex[2] - y * ey[2]) / l[2];
+        const Vec3 p = x * ex + y * ey + t * l;
+        for (size_t k = 0; k < 2; ++k) {
+          column.min[k] = std::min(column.min[k], p[k]);
+          column.max[k] = std::max(column.max[k], p[k]);
+        }
+      }
+    Bounds inside;
+    bool empty = false;
+    for (size_t k = 0; k < 3; ++k) {
+      inside.min[k] = std::max(world_box.min[k], column.min[k]);
+      inside.max[k] = std::min(world_box.max[k], column.max[k]);
+      empty = empty || inside.min[k] > inside.max[k];
+    }
+    if (empty) continue;
+    any = true;
+    for (const Vec3& corner : box_corners(inside)) {
+      const double depth = dot(l, corner);
+      f.min[2] = std::min(f.min[2], depth);
+      f.max[2] = std::max(f.max[2], depth);
+    }
+  }
+  return any;
+}
+
 std::optional<ShadowFrustum> fit_shadow_frustum(const Vec3& towards_light, std::span<const ShadowCaster> casters,
                                                 double receiver_height, double margin_m, double min_elevation_sin) {
   if (casters.empty()) return std::nullopt;

@@ -55,6 +55,13 @@ struct ShadowFrustum {
 // and the receiver patch. The box is square across the light (square texels).
 // nullopt when there is nothing to cast or the light is not above the receiver plane
 // (towards_light.z below min_elevation_sin): then no shadow falls on it.
+// A directional frustum's depth range grown to hold the part of a caster inside its column of
+// light (the box across the light, along it without end): where a real caster fitted for the
+// virtual objects alone must still be drawn. world_box: the caster's (or one of its clusters')
+// world-frame axis-aligned box. Conservative: it takes the box's part within the column's own box,
+// in 8 slabs of the caster's height. Whether anything of it was inside.
+bool extend_depth_over(ShadowFrustum& frustum, const Bounds& world_box);
+
 std::optional<ShadowFrustum> fit_shadow_frustum(const Vec3& towards_light, std::span<const ShadowCaster> casters,
                                                 double receiver_height, double margin_m,
                                                 double min_elevation_sin = 0.02);

@@ -33,7 +33,12 @@ bool may_shadow(const LightBox& other, const LightBox& target, double reach_m) {
 }  // namespace
 
 double shadow_lookup_reach_m(const ShadowLookup& lookup, const ShadowFrustum& frustum) {
-  const double texels = 1.0 + std::max(lookup.method == ShadowMethod::Pcss ? double(lookup.max_search_texels) : 0.0,
+  // PCSS searches and filters over at most the penumbra a blocker at the light's end of the depth
+  // range would cast (a directional light's is per_depth texels: depths lie in [0, 1]), and never
+  // beyond max_search_texels.
+  double pcss = lookup.max_search_texels;
+  if (!lookup.local) pcss = std::min(pcss, std::max(double(lookup.penumbra_texels_per_depth), 1.0));
+  const double texels = 1.0 + std::max(lookup.method == ShadowMethod::Pcss ? pcss : 0.0,
                                        lookup.method == ShadowMethod::Pcf ? double(lookup.pcf_radius_texels) : 0.0);
   return texels * double(lookup.texel) * frustum.width_m();
 }

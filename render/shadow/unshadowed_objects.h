@@ -24,7 +24,7 @@ std::vector<const UploadedObject*> unshadowed_objects(std::span<const UploadedOb
                                                       const ShadowFrustum& frustum, ShadowMethod method, double reach_m);
 
 // How far from a point a lookup of this map reads (the PCSS search or the PCF kernel, a texel
-// more), in metres across the map.
+// more), in metres across the map, along either of its axes (a square window).
 double shadow_lookup_reach_m(const ShadowLookup& lookup, const ShadowFrustum& frustum);
 
 }  // namespace arpipe

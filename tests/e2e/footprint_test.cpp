@@ -17,6 +17,7 @@
 
 #include "capture/recording/recording_reader.h"
 #include "capture/recording/recording_writer.h"
+#include "child_process.h"
 #include "kept_frames.h"
 
 namespace fs = std::filesystem;
@@ -115,6 +116,40 @@ TEST(Footprint, ShadowsFarOutsideTheObjectsAreTheFullCanvasPicture) {
     if (footprint[i].drawn && overhead[i].drawn && footprint[i].layer.rect_width > overhead[i].layer.rect_width + 20)
       ++wider;
   EXPECT_GT(wider, 10);
+  EXPECT_LE(largest_difference(footprint, full), 1);
+}
+
+// Seed 003's hybrid on the courtyard of `arpipe bench hybrid`: four cubes stand all around the
+// panorama's viewer, so that in most views one is ahead and others beside or behind the camera,
+// their boxes and shadows cut by the near plane; the whole courtyard is one proxy that catches the
+// shadows and casts its own. The footprint holds what is drawn (the same picture as the full
+// canvas), and it is not the whole picture: neither the ground catcher's patch around all four
+// cubes nor the courtyard proxy's box spreads it over the frame.
+TEST(Footprint, ObjectsAllAroundAPanoramaViewerAreTheFullCanvasPicture) {
+  const fs::path out = kBuild / "e2e-out" / "footprint-courtyard";
+  fs::remove_all(out);
+  fs::create_directories(out);
+  std::string err;
+  ASSERT_EQ(test::run_to_exit(test::build_program("arpipe"),
+                              {"simulate", "--scene", (kConfigs / "sim" / "courtyard.toml").string(), "--out",
+                               (out / "still").string(), "--png", "--samples", "1", "--export-glb",
+                               (out / "world.glb").string()},
+                              out / "logs-simulate", &err),
+            0)
+      << err;
+  // 30 degrees a frame from -10: every cube passes ahead, beside and behind.
+  const std::vector<std::string> sweep = with(
+      kDrawEveryFrame, {"source.panorama.file=\"" + (out / "still" / "frame_000000.png").string() + "\"",
+                        "render.proxies.0.mesh=\"" + (out / "world.glb").string() + "\"",
+                        "source.panorama.view.yaw_deg_per_s=900.0", "source.panorama.view.frames=12"});
+  const auto footprint = run(kConfigs / "courtyard.toml", out, 12, sweep);
+  const auto full = run(kConfigs / "courtyard.toml", out, 12, with(sweep, {"render.full_canvas=true"}));
+  ASSERT_EQ(footprint.size(), 12u);
+  int small = 0;
+  for (const Shown& shown : footprint)
+    if (shown.drawn && shown.layer.rect_width * shown.layer.rect_height < shown.layer.width * shown.layer.height / 4)
+      ++small;
+  EXPECT_GE(small, 6) << "frames drawn in less than a quarter of the picture";
   EXPECT_LE(largest_difference(footprint, full), 1);
 }
 

@@ -1,6 +1,6 @@
 // Tests of the screen rectangle of an object's box: it holds every projected point of the box,
-// it is the whole image when the box reaches behind the camera, and it is absent when the box is
-// out of view.
+// that of its part in front of the near plane when it reaches behind the camera, and it is absent
+// when the box is out of view.
 #include "render/projected_bounds.h"
 
 #include <gtest/gtest.h>
@@ -57,14 +57,37 @@ TEST(ProjectedBounds, MarginWidensAndTheImageClips) {
   EXPECT_EQ(close, PixelRect::full(320, 240));
 }
 
-TEST(ProjectedBounds, BoxAcrossTheNearPlaneGivesTheWholeImage) {
-  // The camera inside the box, and a camera whose image plane cuts through the box beside it:
-  // part of the box is behind the camera, where no projection bounds it, so the answer must be
-  // the whole image (the safe side).
+TEST(ProjectedBounds, BoxAcrossTheNearPlaneIsBoundedByItsPartInFront) {
+  // The camera inside the box: its part in front surrounds the view, the whole image.
   EXPECT_EQ(projected_box_rect(kCamera, look_at({0.0, 0.0, 0.03}, {1.0, 0.0, 0.03}), kBox, 2.0),
             PixelRect::full(320, 240));
-  EXPECT_EQ(projected_box_rect(kCamera, look_at({0.0, -0.5, 0.03}, {1.0, -0.5, 0.03}), kBox, 2.0),
-            PixelRect::full(320, 240));
+  // The image plane cuts through the box beside the camera, whose part in front lies 86 degrees off
+  // the axis: out of view, as GL clips it.
+  EXPECT_FALSE(projected_box_rect(kCamera, look_at({0.0, -0.5, 0.03}, {1.0, -0.5, 0.03}), kBox, 2.0).has_value());
+  // A camera 1 cm beside the box's face, looking along it: the part in front of the near plane
+  // reaches into the image from one side. Every point of it that projects into the image lies in
+  // the rectangle, and the rectangle is not the whole image.
+  const SE3 pose = look_at({0.0, -0.04, 0.03}, {1.0, -0.04, 0.03});
+  const auto rect = projected_box_rect(kCamera, pose, kBox, 0.0);
+  ASSERT_TRUE(rect.has_value());
+  EXPECT_LT(rect->width, 320);
+  int inside = 0;
+  for (int i = 0; i <= 40; ++i)
+    for (int j = 0; j <= 40; ++j)
+      for (int k = 0; k <= 40; ++k) {
+        const Vec3 p = pose * Vec3{kBox.min[0] + (kBox.max[0] - kBox.min[0]) * i / 40,
+                                   kBox.min[1] + (kBox.max[1] - kBox.min[1]) * j / 40,
+                                   kBox.min[2] + (kBox.max[2] - kBox.min[2]) * k / 40};
+        if (p[2] <= 0.01) continue;  // behind the near plane: GL draws none of it
+        const auto pixel = kCamera.project(p);
+        if (!pixel || (*pixel)[0] < -0.5 || (*pixel)[0] >= 319.5 || (*pixel)[1] < -0.5 || (*pixel)[1] >= 239.5) continue;
+        ++inside;
+        EXPECT_GE((*pixel)[0], rect->x - 0.5);
+        EXPECT_LT((*pixel)[0], rect->right() - 0.5);
+        EXPECT_GE((*pixel)[1], rect->y - 0.5);
+        EXPECT_LT((*pixel)[1], rect->bottom() - 0.5);
+      }
+  EXPECT_GT(inside, 100);  // the case is the one meant: much of the box is in view
 }
 
 TEST(ProjectedBounds, BoxBehindOrBesideTheViewIsAbsent) {

@@ -86,3 +86,46 @@ TEST(ShadowFrustum, NoShadowFromBelowTheGroundOrAmongTheObjects) {
 
 }  // namespace
 }  // namespace arpipe
+
+namespace arpipe {
+namespace {
+
+// A map fitted around the small casters alone, then grown along the light for a 30 m floor and a
+// 3 m column beside them (a courtyard of proxies): it takes in every point of theirs inside its
+// column of light (sampled densely), and only a little more along the light than that part spans;
+// a box wholly outside the column leaves it as it was.
+TEST(ShadowFrustum, DepthGrowsOnlyByWhatLiesInTheColumn) {
+  const Vec3 towards = normalized(Vec3{-0.5, 0.55, 0.67});
+  const ShadowFrustum fitted = *fit_shadow_frustum(towards, kCasters, 0.0, 0.005);
+  const Bounds floor{{-15, -15, 0}, {15, 15, 0}};
+  const Bounds column{{-0.3, 0.2, 0}, {-0.1, 0.4, 3.0}};  // up-light of the casters: it shades them
+  ShadowFrustum grown = fitted;
+  ASSERT_TRUE(extend_depth_over(grown, floor));
+  ASSERT_TRUE(extend_depth_over(grown, column));
+  EXPECT_FALSE(extend_depth_over(grown, Bounds{{8, 8, 0}, {9, 9, 1}}));
+  EXPECT_EQ(grown.min[0], fitted.min[0]);
+  EXPECT_EQ(grown.max[1], fitted.max[1]);
+  const Vec3 l = towards;
+  double lo = INFINITY, hi = -INFINITY;  // the sampled points' depths inside the column
+  for (const Bounds& box : {floor, column})
+    for (int i = 0; i <= 300; ++i)
+      for (int j = 0; j <= 300; ++j)
+        for (int k = 0; k <= (box.max[2] > box.min[2] ? 30 : 0); ++k) {
+          const Vec3 p{box.min[0] + (box.max[0] - box.min[0]) * i / 300, box.min[1] + (box.max[1] - box.min[1]) * j / 300,
+                       box.min[2] + (box.max[2] - box.min[2]) * k / 30};
+          const Vec3 q = mat_mul(fitted.R_light_world, p);
+          if (q[0] < fitted.min[0] || q[0] > fitted.max[0] || q[1] < fitted.min[1] || q[1] > fitted.max[1]) continue;
+          lo = std::min(lo, dot(l, p));
+          hi = std::max(hi, dot(l, p));
+        }
+  ASSERT_LT(lo, hi);
+  EXPECT_LE(grown.min[2], lo);
+  EXPECT_GE(grown.max[2], hi);
+  // Conservative by a slab's worth (an eighth of the column's 3 m, leaning 1 / l_z along the
+  // light), not by the floor's 30 m: the floor alone would span about 22 m along this light.
+  EXPECT_LE((grown.max[2] - grown.min[2]) - (hi - lo), (3.0 / 8) / l[2]);
+  EXPECT_LT(grown.max[2] - grown.min[2], 5.0);
+}
+
+}  // namespace
+}  // namespace arpipe

@@ -149,3 +149,33 @@ TEST(UnshadowedObjects, TheShadowedCubeKeepsItsShadowAndTheLoneOneIsExactLambert
 
 }  // namespace
 }  // namespace arpipe
+
+namespace arpipe {
+namespace {
+
+// How far a lookup reads, in metres across the map: a PCF kernel's half-width, or the PCSS search,
+// which for a directional light is at most the penumbra of a blocker at the light's end of the
+// depth range (per_depth texels) and never beyond max_search; a texel more for the bilinear tap.
+TEST(ShadowLookupReach, PcssReadsNoFurtherThanTheWidestPenumbraOrTheSearchCap) {
+  ShadowFrustum frustum;
+  frustum.min = {0, 0, 0};
+  frustum.max = {2.048, 2.048, 1};  // 2 mm texels on a 1024 map
+  ShadowLookup lookup;
+  lookup.texel = 1.0f / 1024;
+  lookup.method = ShadowMethod::Pcss;
+  lookup.max_search_texels = 32;
+  lookup.penumbra_texels_per_depth = 5;
+  EXPECT_NEAR(shadow_lookup_reach_m(lookup, frustum), 6 * 0.002, 1e-9);
+  lookup.penumbra_texels_per_depth = 100;
+  EXPECT_NEAR(shadow_lookup_reach_m(lookup, frustum), 33 * 0.002, 1e-9);
+  lookup.penumbra_texels_per_depth = 0.1f;  // the search reads at least a texel around
+  EXPECT_NEAR(shadow_lookup_reach_m(lookup, frustum), 2 * 0.002, 1e-9);
+  lookup.local = true;  // a lamp's penumbra grows towards it: the cap
+  EXPECT_NEAR(shadow_lookup_reach_m(lookup, frustum), 33 * 0.002, 1e-9);
+  lookup.method = ShadowMethod::Pcf;
+  lookup.pcf_radius_texels = 1.5f;
+  EXPECT_NEAR(shadow_lookup_reach_m(lookup, frustum), 2.5 * 0.002, 1e-9);
+}
+
+}  // namespace
+}  // namespace arpipe
