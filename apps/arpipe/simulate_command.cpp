@@ -1,12 +1,15 @@
 // arpipe simulate: renders a simulator scene (configs/sim/*.toml) into a recording with ground truth.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <exception>
 #include <memory>
 #include <new>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "apps/arpipe/commands.h"
 #include "apps/cli/command_line.h"
@@ -28,6 +31,7 @@ struct SimulateOptions {
   int samples = 0;  // 0: the scene's render.samples_per_pixel
   bool png = false;  // also each frame as DIR/frame_NNNNNN.png
   std::string export_glb;  // also the real objects and lights as this .glb
+  std::vector<std::string> export_leave_out;  // objects (by name) the .glb leaves out
   std::string video;       // also the frames as this 360° MP4 (a LENSMODEL_LONLAT camera's)
 };
 
@@ -56,7 +60,14 @@ int run_simulate(SimulateOptions& command) {
   }
   if (!command.export_glb.empty()) {  // before the frames: a scene it cannot export fails fast
     try {
-      const std::vector<uint8_t> glb = sim::export_scene_glb(scene);
+      sim::SimScene exported = scene;
+      for (const std::string& name : command.export_leave_out) {
+        const auto named = [&](const sim::SimObject& o) { return o.name == name; };
+        if (std::find_if(exported.objects.begin(), exported.objects.end(), named) == exported.objects.end())
+          throw std::invalid_argument(fmt::format("--export-leave-out {}: the scene has no object of that name", name));
+        std::erase_if(exported.objects, named);
+      }
+      const std::vector<uint8_t> glb = sim::export_scene_glb(exported);
       if (const int error = replace_file(command.export_glb, glb))
         throw std::runtime_error(fmt::format("{}: {}", command.export_glb, std::strerror(error)));
       log::info("wrote the real objects and {} lights to {}", scene.lights.size(), command.export_glb);
@@ -132,6 +143,10 @@ void add_simulate_command(CLI::App& arpipe) {
                       "also write the real objects (one mesh in the world frame, for render.proxies) and the lights "
                       "(KHR_lights_punctual, for light.panorama.lights_file) as a binary glTF")
       ->type_name("FILE");
+  command->add_option("--export-leave-out", options->export_leave_out,
+                      "leave this object (by its name in the scene) out of --export-glb: the real ground, which "
+                      "render.shadows' ground catcher stands for; repeatable")
+      ->type_name("NAME");
   command->add_option("--video", options->video,
                       "also write the frames as a 360° H.264 MP4 with spherical metadata (a LENSMODEL_LONLAT camera's, "
                       "mono or its [camera.stereo] pair)")

@@ -12,6 +12,7 @@
 #include "capture/recording/recording_reader.h"
 #include "capture/recording/recording_writer.h"
 #include "core/image/radiance_hdr.h"
+#include "core/scene/gltf_loader.h"
 #include "tests/e2e/child_process.h"
 
 namespace fs = std::filesystem;
@@ -233,6 +234,30 @@ TEST_F(ArpipeCli, SimulateNamesTheBadSceneFileAndKey) {
                 nullptr, &err),
             2);
   EXPECT_NE(err.find("--samples"), std::string::npos) << err;
+}
+
+// --export-leave-out takes an object out of the exported proxies by name (the real ground, which
+// the ground catcher stands for): the GLB holds the rest, 2 triangles fewer for the courtyard's
+// paving; a name the scene lacks is an error naming it, before any frame.
+TEST_F(ArpipeCli, SimulateExportLeavesOutTheNamedObject) {
+  const fs::path scene = fs::path(ARPIPE_SOURCE_DIR) / "configs" / "sim" / "courtyard.toml";
+  std::string err;
+  for (const auto& [glb, leave_out] : {std::pair{"all.glb", ""}, std::pair{"standing.glb", "paving"}}) {
+    std::vector<std::string> args{"simulate", "--scene", scene.string(), "--out", (dir_ / glb).replace_extension().string(),
+                                  "--samples", "1", "--frames", "1", "--export-glb", (dir_ / glb).string()};
+    if (*leave_out) args.insert(args.end(), {"--export-leave-out", leave_out});
+    ASSERT_EQ(run(args, nullptr, &err), 0) << err;
+  }
+  const Mesh all = load_gltf_mesh(dir_ / "all.glb");
+  const Mesh standing = load_gltf_mesh(dir_ / "standing.glb");
+  EXPECT_EQ(all.triangle_count(), standing.triangle_count() + 2);  // the paving's rectangle
+  EXPECT_EQ(all.parts.size(), standing.parts.size() + 1);
+  EXPECT_EQ(run({"simulate", "--scene", scene.string(), "--out", (dir_ / "none").string(), "--export-glb",
+                 (dir_ / "none.glb").string(), "--export-leave-out", "lawn"},
+                nullptr, &err),
+            1);
+  EXPECT_NE(err.find("lawn"), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(dir_ / "none"));
 }
 
 TEST_F(ArpipeCli, ConfigDefaultsAreAValidConfigAndCheckNamesErrors) {
