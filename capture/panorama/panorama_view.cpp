@@ -118,22 +118,127 @@ int PanoramaView::levels_needed(const EquirectImage& panorama, const Mat3& R_pan
   return level + 1;
 }
 
+PanoramaView::Turn PanoramaView::split_turn(const Mat3& R_pano_cam, int panorama_width) {
+  // The forward axis's longitude (as pixel_of measures it) is the yaw; Ry(yaw) takes it to 0.
+  const double yaw = std::atan2(R_pano_cam[0][2], -R_pano_cam[2][2]);
+  const double c = std::cos(yaw), s = std::sin(yaw);
+  const Mat3 Ry{{{c, 0, s}, {0, 1, 0}, {-s, 0, c}}};  // longitude(Ry d) = longitude(d) - yaw
+  Turn turn;
+  turn.rest = mat_mul(Ry, R_pano_cam);
+  turn.yaw_texels = yaw / (2 * std::numbers::pi) * panorama_width;
+  return turn;
+}
+
+bool PanoramaView::table_matches(const EquirectImage& panorama, const Mat3& rest) const {
+  if (table_.width != panorama.width() || table_.height != panorama.height()) return false;
+  for (size_t r = 0; r < 3; ++r)
+    for (size_t c = 0; c < 3; ++c)
+      if (std::abs(table_.rest[r][c] - rest[r][c]) > 1e-12) return false;
+  return true;
+}
+
+bool PanoramaView::uses_yaw_table(const EquirectImage& panorama, const Mat3& R_pano_cam) const {
+  return !table_.entries.empty() && table_.levels <= panorama.built_levels() &&
+         table_matches(panorama, split_turn(R_pano_cam, panorama.width()).rest);
+}
+
 void PanoramaView::lookup_positions(const EquirectImage& panorama, const Mat3& R_pano_cam,
                                     std::vector<std::array<float, 2>>& out) const {
-  const auto R = to_float(R_pano_cam);
   out.resize(rays_.size());
+  if (uses_yaw_table(panorama, R_pano_cam)) {
+    const float shift = float(split_turn(R_pano_cam, panorama.width()).yaw_texels);
+    const float width = float(panorama.width());
+    for (size_t i = 0; i < rays_.size(); ++i) {
+      float u = table_.entries[i].u + shift;
+      u -= width * std::floor((u + 0.5f) / width);
+      out[i] = {u, table_.entries[i].v};
+    }
+    return;
+  }
+  const auto R = to_float(R_pano_cam);
   for (size_t i = 0; i < rays_.size(); ++i) out[i] = pixel_of(rotate(R, rays_[i]), panorama.width(), panorama.height());
 }
 
 void PanoramaView::render(EquirectImage& panorama, const Mat3& R_pano_cam, uint8_t* rgb, size_t stride) const {
-  panorama.build_levels(levels_needed(panorama, R_pano_cam));
+  const int levels = levels_needed(panorama, R_pano_cam);
+  panorama.build_levels(levels);
+  const Turn turn = split_turn(R_pano_cam, panorama.width());
   // Bands of rows, one a core: every pixel is looked up on its own, so the result is the same.
   const int height = camera_->height();
   const int bands = std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, std::min(kMaxBands, height));
-  std::vector<std::jthread> helpers;
-  for (int b = 1; b < bands; ++b)
-    helpers.emplace_back([&, b] { render_rows(panorama, R_pano_cam, rgb, stride, height * b / bands, height * (b + 1) / bands); });
-  render_rows(panorama, R_pano_cam, rgb, stride, 0, height / bands);
+  const auto in_bands = [&](const auto& rows) {
+    std::vector<std::jthread> helpers;
+    for (int b = 1; b < bands; ++b) helpers.emplace_back([&, b] { rows(height * b / bands, height * (b + 1) / bands); });
+    rows(0, height / bands);
+  };
+  if (!table_matches(panorama, turn.rest)) {  // a new tilt: looked up directly; the table waits for a second frame
+    table_ = YawTable{turn.rest, panorama.width(), panorama.height(), 0, {}};
+    in_bands([&](int first, int end) { render_rows(panorama, R_pano_cam, rgb, stride, first, end); });
+    return;
+  }
+  if (table_.entries.empty() || table_.levels < levels) {
+    table_.entries.resize(rays_.size());
+    table_.levels = panorama.built_levels();
+    in_bands([&](int first, int end) { make_table_rows(panorama, first, end); });
+  }
+  in_bands([&](int first, int end) { render_rows_from_table(panorama, turn.yaw_texels, rgb, stride, first, end); });
+}
+
+void PanoramaView::make_table_rows(const EquirectImage& panorama, int first_row, int end_row) const {
+  const auto R = to_float(table_.rest);
+  const int width = camera_->width();
+  const float texel_angle = kPi / float(panorama.height());
+  const int last_level = table_.levels - 1;
+  for (int y = first_row; y < end_row; ++y)
+    for (int x = 0; x < width; ++x) {
+      const size_t i = size_t(y) * size_t(width) + size_t(x);
+      const std::array<float, 4>& ray = rays_[i];
+      const std::array<float, 3> d = rotate(R, ray);
+      const std::array<float, 2> p = pixel_of(d, panorama.width(), panorama.height());
+      // As render_rows: the footprint in level-0 texels, the level and the taps across.
+      const float tall = ray[3] / texel_angle;
+      const float wide = tall / std::max(std::sqrt(d[0] * d[0] + d[2] * d[2]), 1e-6f);
+      int level = 0;
+      while (level < last_level && (tall > kMostTexelsDown * float(1 << level) || wide > float(kMaxTapsAcross << level)))
+        ++level;
+      const float scale = 1.0f / float(1 << level);
+      TableEntry& e = table_.entries[i];
+      e.u = p[0];
+      e.v = p[1];
+      e.wide_scaled = wide * scale;
+      e.level = static_cast<uint8_t>(level);
+      e.taps = static_cast<uint8_t>(std::clamp(static_cast<int>(std::ceil(wide * scale)), 1, kMaxTapsAcross));
+    }
+}
+
+void PanoramaView::render_rows_from_table(const EquirectImage& panorama, double yaw_texels, uint8_t* rgb, size_t stride,
+                                          int first_row, int end_row) const {
+  const int width = camera_->width();
+  const float panorama_width = float(panorama.width());
+  const float shift = float(yaw_texels);
+  for (int y = first_row; y < end_row; ++y) {
+    uint8_t* row = rgb + size_t(y) * stride;
+    for (int x = 0; x < width; ++x) {
+      const TableEntry& e = table_.entries[size_t(y) * size_t(width) + size_t(x)];
+      float u0 = e.u + shift;
+      u0 -= panorama_width * std::floor((u0 + 0.5f) / panorama_width);
+      const float scale = 1.0f / float(1 << e.level);
+      const float u = (u0 + 0.5f) * scale - 0.5f, v = (e.v + 0.5f) * scale - 0.5f;
+      uint8_t* out = row + 3 * size_t(x);
+      if (e.taps == 1) {
+        panorama.sample(e.level, u, v, out);
+        continue;
+      }
+      const float step = e.wide_scaled / float(e.taps);
+      float sum[3] = {0, 0, 0};
+      for (int t = 0; t < e.taps; ++t) {
+        uint8_t s[3];
+        panorama.sample(e.level, u + (float(t) + 0.5f) * step - 0.5f * e.wide_scaled, v, s);
+        for (int c = 0; c < 3; ++c) sum[c] += float(s[c]);
+      }
+      for (int c = 0; c < 3; ++c) out[c] = static_cast<uint8_t>(sum[c] / float(e.taps) + 0.5f);
+    }
+  }
 }
 
 void PanoramaView::render_rows(const EquirectImage& panorama, const Mat3& R_pano_cam, uint8_t* rgb, size_t stride,

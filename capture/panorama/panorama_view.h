@@ -44,9 +44,38 @@ class PanoramaView {
   // The level-0 panorama position each pixel's ray meets (row-major), as render computes it.
   void lookup_positions(const EquirectImage& panorama, const Mat3& R_pano_cam, std::vector<std::array<float, 2>>& out) const;
 
+  // Whether render and lookup_positions take this turn from the yaw-free table (below).
+  bool uses_yaw_table(const EquirectImage& panorama, const Mat3& R_pano_cam) const;
+
  private:
+  // A turn split into a yaw about the panorama's up and the rest: R_pano_cam = Ry(-yaw) rest, with
+  // rest's forward axis at longitude 0. A yaw moves every pixel's longitude by the same amount and
+  // leaves its latitude, level and taps as they were.
+  struct Turn {
+    double yaw_texels = 0;  // the longitude shift, in level-0 texels
+    Mat3 rest{};
+  };
+  static Turn split_turn(const Mat3& R_pano_cam, int panorama_width);
+  // Per pixel at yaw 0: the level-0 position, the footprint across at the pixel's level, the level
+  // and the taps. Made on the second frame in a row with the same rest (a sweep, a still head),
+  // then each frame costs a shift and the sampling: the rotation and both atan2 are done once.
+  struct TableEntry {
+    float u = 0, v = 0, wide_scaled = 0;
+    uint8_t level = 0, taps = 1;
+  };
+  struct YawTable {
+    Mat3 rest{};
+    int width = 0, height = 0, levels = 0;  // the panorama's size, and the levels the table may pick
+    std::vector<TableEntry> entries;        // empty: `rest` was last frame's, the table not made yet
+  };
+  bool table_matches(const EquirectImage& panorama, const Mat3& rest) const;
+  void make_table_rows(const EquirectImage& panorama, int first_row, int end_row) const;
+  void render_rows_from_table(const EquirectImage& panorama, double yaw_texels, uint8_t* rgb, size_t stride,
+                              int first_row, int end_row) const;
   void render_rows(const EquirectImage& panorama, const Mat3& R_pano_cam, uint8_t* rgb, size_t stride, int first_row,
                    int end_row) const;
+  // render() is called from one thread at a time (the source's), which alone changes the table.
+  mutable YawTable table_;
   std::shared_ptr<const CameraModel> camera_;
   // Per pixel: the unit ray (camera frame) and the angle to its neighbours (radians).
   std::vector<std::array<float, 4>> rays_;

@@ -62,20 +62,32 @@ double texels_apart(const std::array<float, 2>& a, const Vec2& b, int width, int
   return std::atan2(norm(cross(da, db)), dot(da, db)) / (kPi / height);
 }
 
-TEST(PanoramaView, LookupAgreesWithDoublePrecisionAtEveryLatitudeAndAlongTheSeam) {
-  // A 1080p view of a 4096 x 2048 panorama, turned to the seam and to both poles among others: the
-  // position each pixel looks up (float) against the same remap in double (mrcal's unprojection,
-  // the rotation and environment_direction_pixel), per band of 10 degrees of latitude.
+// A 1080p view of a 4096 x 2048 panorama, turned to the seam and to both poles among others: the
+// position each pixel looks up (float) against the same remap in double (mrcal's unprojection,
+// the rotation and environment_direction_pixel), per band of 10 degrees of latitude. Directly, and
+// from the yaw-free table that a sweep's frames use (made by two frames at another yaw, the same
+// tilt), which must meet the same bars.
+void expect_lookup_agrees_with_double_precision(bool from_table) {
   constexpr int W = 4096, H = 2048;
-  const EquirectImage panorama(std::vector<uint8_t>(size_t(W) * H * 3, 128), W, H, "grey");
+  EquirectImage panorama(std::vector<uint8_t>(size_t(W) * H * 3, 128), W, H, "grey");
   const double fx = 0.5 * 1920 / std::tan(45 * kDeg);
   const auto camera = std::make_shared<const CameraModel>(CameraModel::pinhole(fx, fx, 959.5, 539.5, 1920, 1080));
   const PanoramaView view(camera);
   std::array<double, 19> sum{}, most{};
   std::array<int, 19> count{};
+  std::vector<uint8_t> picture(size_t(1920) * 1080 * 3);
   for (const auto& [yaw, pitch] : std::vector<std::pair<double, double>>{
            {0, 0}, {180, 0}, {-179.9, 30}, {180, -45}, {33, 89.9}, {0, 90}, {-120, -90}, {77, -60}, {250, 60}}) {
     const Mat3 R = panorama_view_rotation(yaw * kDeg, pitch * kDeg);
+    if (from_table) {
+      const Mat3 before = panorama_view_rotation((yaw - 97) * kDeg, pitch * kDeg);
+      view.render(panorama, before, picture.data(), 1920 * 3);
+      view.render(panorama, before, picture.data(), 1920 * 3);
+      // (Straight up or down the view's axis does not define the yaw: the table may or may not match.)
+      if (std::abs(pitch) < 90) {
+        EXPECT_TRUE(view.uses_yaw_table(panorama, R)) << "yaw " << yaw << " pitch " << pitch;
+      }
+    }
     std::vector<std::array<float, 2>> positions;
     view.lookup_positions(panorama, R, positions);
     for (int y = 0; y < 1080; y += 3)
@@ -96,6 +108,12 @@ TEST(PanoramaView, LookupAgreesWithDoublePrecisionAtEveryLatitudeAndAlongTheSeam
     EXPECT_LE(most[band], 0.5) << "max, latitude " << int(band) * 10 - 90;
   }
 }
+
+TEST(PanoramaView, LookupAgreesWithDoublePrecisionAtEveryLatitudeAndAlongTheSeam) {
+  expect_lookup_agrees_with_double_precision(false);
+}
+
+TEST(PanoramaView, TheSweepsYawFreeTableAgreesWithDoublePrecisionToo) { expect_lookup_agrees_with_double_precision(true); }
 
 // A smooth colour field over the sphere: each channel a different low-order function of the
 // direction, between 20 and 235.
@@ -188,19 +206,26 @@ TEST(PanoramaView, PyramidBuiltOnDemandGivesTheSamePictureAsTheWholePyramid) {
   };
   for (const View v : {View{640, 480, 60}, View{64, 48, 120}, View{160, 120, 170}}) {
     const double fx = 0.5 * v.width / std::tan(0.5 * v.hfov_deg * kDeg);
-    const PanoramaView view(std::make_shared<const CameraModel>(
-        CameraModel::pinhole(fx, fx, 0.5 * (v.width - 1), 0.5 * (v.height - 1), v.width, v.height)));
-    for (const double pitch : {0.0, 30.0, 60.0, 80.0, 89.0, 90.0, -45.0, -90.0}) {
-      const Mat3 R = panorama_view_rotation(1.3, pitch * kDeg);
-      EquirectImage lazy(rgb, W, H, "noise");
-      std::vector<uint8_t> a(size_t(v.width) * size_t(v.height) * 3), b(a.size());
-      view.render(lazy, R, a.data(), size_t(v.width) * 3);
-      view.render(whole, R, b.data(), size_t(v.width) * 3);
-      EXPECT_EQ(a, b) << v.width << "x" << v.height << ", pitch " << pitch << ": " << lazy.built_levels() << " levels built";
-      if (v.width == 640 && std::abs(pitch) <= 30) {
-        EXPECT_EQ(lazy.built_levels(), 1) << "pitch " << pitch;
+    const auto camera = std::make_shared<const CameraModel>(
+        CameraModel::pinhole(fx, fx, 0.5 * (v.width - 1), 0.5 * (v.height - 1), v.width, v.height));
+    // Each lookup on a view of its own: the first frame of a tilt is looked up directly, the next
+    // from the yaw-free table (both paths, each against itself).
+    for (const double pitch : {0.0, 30.0, 60.0, 80.0, 89.0, 90.0, -45.0, -90.0})
+      for (const int frames : {1, 2}) {
+        const Mat3 R = panorama_view_rotation(1.3, pitch * kDeg);
+        EquirectImage lazy(rgb, W, H, "noise");
+        std::vector<uint8_t> a(size_t(v.width) * size_t(v.height) * 3), b(a.size());
+        const PanoramaView on_lazy(camera), on_whole(camera);
+        for (int f = 0; f < frames; ++f) {
+          on_lazy.render(lazy, R, a.data(), size_t(v.width) * 3);
+          on_whole.render(whole, R, b.data(), size_t(v.width) * 3);
+        }
+        EXPECT_EQ(a, b) << v.width << "x" << v.height << ", pitch " << pitch << ", frame " << frames << ": "
+                        << lazy.built_levels() << " levels built";
+        if (v.width == 640 && std::abs(pitch) <= 30) {
+          EXPECT_EQ(lazy.built_levels(), 1) << "pitch " << pitch;
+        }
       }
-    }
   }
 }
 
