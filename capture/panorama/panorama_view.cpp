@@ -76,6 +76,51 @@ namespace {
   return {(0.5f + longitude / (2 * kPi)) * float(width) - 0.5f, from_up / kPi * float(height) - 0.5f};
 }
 
+// Where a pixel's ray looks and how it is sampled there: its level-0 position, the pyramid level
+// where its footprint spans at most kMostTexelsDown texels down and kMaxTapsAcross across (texels
+// narrow as cos(latitude)), that footprint across at the level, and the taps spread over it.
+struct RayLookup {
+  std::array<float, 2> position;
+  int level = 0;
+  float wide_scaled = 0;
+  int taps = 1;
+};
+[[gnu::always_inline]] inline RayLookup look_up(const std::array<std::array<float, 3>, 3>& R, const std::array<float, 4>& ray,
+                                                const EquirectImage& panorama, float texel_angle, int last_level) {
+  const std::array<float, 3> d = rotate(R, ray);
+  RayLookup out;
+  out.position = pixel_of(d, panorama.width(), panorama.height());
+  // The pixel's footprint in level-0 texels: down (ray[3], its angle to its neighbours), and across.
+  const float tall = ray[3] / texel_angle;
+  const float wide = tall / std::max(std::sqrt(d[0] * d[0] + d[2] * d[2]), 1e-6f);
+  while (out.level < last_level &&
+         (tall > kMostTexelsDown * float(1 << out.level) || wide > float(kMaxTapsAcross << out.level)))
+    ++out.level;
+  out.wide_scaled = wide / float(1 << out.level);
+  out.taps = std::clamp(static_cast<int>(std::ceil(out.wide_scaled)), 1, kMaxTapsAcross);
+  return out;
+}
+
+// The pixel's colour: the level-0 position (u0, v0) at `level`, one bilinear tap, or `taps` spread
+// evenly across its footprint and averaged.
+[[gnu::always_inline]] inline void sample_footprint(const EquirectImage& panorama, float u0, float v0, int level,
+                                                    float wide_scaled, int taps, uint8_t out[3]) {
+  const float scale = 1.0f / float(1 << level);
+  const float u = (u0 + 0.5f) * scale - 0.5f, v = (v0 + 0.5f) * scale - 0.5f;
+  if (taps == 1) {
+    panorama.sample(level, u, v, out);
+    return;
+  }
+  const float step = wide_scaled / float(taps);
+  float sum[3] = {0, 0, 0};
+  for (int t = 0; t < taps; ++t) {
+    uint8_t s[3];
+    panorama.sample(level, u + (float(t) + 0.5f) * step - 0.5f * wide_scaled, v, s);
+    for (int c = 0; c < 3; ++c) sum[c] += float(s[c]);
+  }
+  for (int c = 0; c < 3; ++c) out[c] = static_cast<uint8_t>(sum[c] / float(taps) + 0.5f);
+}
+
 }  // namespace
 
 PanoramaView::PanoramaView(std::shared_ptr<const CameraModel> camera) : camera_(std::move(camera)) {
@@ -188,26 +233,12 @@ void PanoramaView::make_table_rows(const EquirectImage& panorama, int first_row,
   const auto R = to_float(table_.rest);
   const int width = camera_->width();
   const float texel_angle = kPi / float(panorama.height());
-  const int last_level = table_.levels - 1;
   for (int y = first_row; y < end_row; ++y)
     for (int x = 0; x < width; ++x) {
       const size_t i = size_t(y) * size_t(width) + size_t(x);
-      const std::array<float, 4>& ray = rays_[i];
-      const std::array<float, 3> d = rotate(R, ray);
-      const std::array<float, 2> p = pixel_of(d, panorama.width(), panorama.height());
-      // As render_rows: the footprint in level-0 texels, the level and the taps across.
-      const float tall = ray[3] / texel_angle;
-      const float wide = tall / std::max(std::sqrt(d[0] * d[0] + d[2] * d[2]), 1e-6f);
-      int level = 0;
-      while (level < last_level && (tall > kMostTexelsDown * float(1 << level) || wide > float(kMaxTapsAcross << level)))
-        ++level;
-      const float scale = 1.0f / float(1 << level);
-      TableEntry& e = table_.entries[i];
-      e.u = p[0];
-      e.v = p[1];
-      e.wide_scaled = wide * scale;
-      e.level = static_cast<uint8_t>(level);
-      e.taps = static_cast<uint8_t>(std::clamp(static_cast<int>(std::ceil(wide * scale)), 1, kMaxTapsAcross));
+      const RayLookup l = look_up(R, rays_[i], panorama, texel_angle, table_.levels - 1);
+      table_.entries[i] = {l.position[0], l.position[1], l.wide_scaled, static_cast<uint8_t>(l.level),
+                           static_cast<uint8_t>(l.taps)};
     }
 }
 
@@ -222,21 +253,7 @@ void PanoramaView::render_rows_from_table(const EquirectImage& panorama, double 
       const TableEntry& e = table_.entries[size_t(y) * size_t(width) + size_t(x)];
       float u0 = e.u + shift;
       u0 -= panorama_width * std::floor((u0 + 0.5f) / panorama_width);
-      const float scale = 1.0f / float(1 << e.level);
-      const float u = (u0 + 0.5f) * scale - 0.5f, v = (e.v + 0.5f) * scale - 0.5f;
-      uint8_t* out = row + 3 * size_t(x);
-      if (e.taps == 1) {
-        panorama.sample(e.level, u, v, out);
-        continue;
-      }
-      const float step = e.wide_scaled / float(e.taps);
-      float sum[3] = {0, 0, 0};
-      for (int t = 0; t < e.taps; ++t) {
-        uint8_t s[3];
-        panorama.sample(e.level, u + (float(t) + 0.5f) * step - 0.5f * e.wide_scaled, v, s);
-        for (int c = 0; c < 3; ++c) sum[c] += float(s[c]);
-      }
-      for (int c = 0; c < 3; ++c) out[c] = static_cast<uint8_t>(sum[c] / float(e.taps) + 0.5f);
+      sample_footprint(panorama, u0, e.v, e.level, e.wide_scaled, e.taps, row + 3 * size_t(x));
     }
   }
 }
@@ -250,32 +267,8 @@ void PanoramaView::render_rows(const EquirectImage& panorama, const Mat3& R_pano
   for (int y = first_row; y < end_row; ++y) {
     uint8_t* row = rgb + size_t(y) * stride;
     for (int x = 0; x < width; ++x) {
-      const std::array<float, 4>& ray = rays_[size_t(y) * size_t(width) + size_t(x)];
-      const std::array<float, 3> d = rotate(R, ray);
-      const std::array<float, 2> p = pixel_of(d, panorama.width(), panorama.height());
-      // The pixel's footprint in level-0 texels: down, and across (texels narrow as cos(latitude)).
-      const float tall = ray[3] / texel_angle;
-      const float wide = tall / std::max(std::sqrt(d[0] * d[0] + d[2] * d[2]), 1e-6f);
-      int level = 0;
-      while (level < last_level && (tall > kMostTexelsDown * float(1 << level) || wide > float(kMaxTapsAcross << level)))
-        ++level;
-      const float scale = 1.0f / float(1 << level);
-      const float u = (p[0] + 0.5f) * scale - 0.5f, v = (p[1] + 0.5f) * scale - 0.5f;
-      const int taps = std::clamp(static_cast<int>(std::ceil(wide * scale)), 1, kMaxTapsAcross);
-      uint8_t* out = row + 3 * size_t(x);
-      if (taps == 1) {
-        panorama.sample(level, u, v, out);
-        continue;
-      }
-      // Taps spread evenly across the footprint, averaged.
-      const float step = wide * scale / float(taps);
-      float sum[3] = {0, 0, 0};
-      for (int t = 0; t < taps; ++t) {
-        uint8_t s[3];
-        panorama.sample(level, u + (float(t) + 0.5f) * step - 0.5f * wide * scale, v, s);
-        for (int c = 0; c < 3; ++c) sum[c] += float(s[c]);
-      }
-      for (int c = 0; c < 3; ++c) out[c] = static_cast<uint8_t>(sum[c] / float(taps) + 0.5f);
+      const RayLookup l = look_up(R, rays_[size_t(y) * size_t(width) + size_t(x)], panorama, texel_angle, last_level);
+      sample_footprint(panorama, l.position[0], l.position[1], l.level, l.wide_scaled, l.taps, row + 3 * size_t(x));
     }
   }
 }
