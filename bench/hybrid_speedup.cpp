@@ -102,10 +102,8 @@ bool is_ground(const sim::SimObject& object, double receiver_height_m) {
 
 // Each real object simplified to 1/ratio of its triangles in its own frame (the seed decimated its
 // proxies about 10:1), those too small to simplify (a plane, a box) kept whole.
-Mesh simplified_world(const sim::SimScene& scene, double ratio, size_t& triangles_before) {
-  triangles_before = 0;
+Mesh simplified_world(const sim::SimScene& scene, double ratio) {
   return sim::real_world_mesh(scene, [&](const Mesh& mesh) {
-    triangles_before += mesh.triangle_count();
     if (double(mesh.triangle_count()) / ratio < 12) return mesh;
     MeshSimplifySettings settings;
     settings.ratio = ratio;
@@ -137,8 +135,7 @@ Inputs make_inputs(const sim::SimScene& scene, const Config& config, const Optio
   in.proxy_triangles = proxies.triangle_count();
   in.proxies_glb = work / "proxies.glb";
   write_file(in.proxies_glb, encode_glb(proxies, "arpipe bench hybrid"));
-  size_t before = 0;
-  const Mesh simplified = simplified_world(standing, options.ratio, before);
+  const Mesh simplified = simplified_world(standing, options.ratio);
   in.simplified_triangles = simplified.triangle_count();
   in.proxies_simplified_glb = work / fmt::format("proxies-{}to1.glb", options.ratio);
   write_file(in.proxies_simplified_glb, encode_glb(simplified, "arpipe bench hybrid"));

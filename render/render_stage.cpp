@@ -45,6 +45,19 @@ struct RenderAssets final : StageAssets {
   LoadedMeshes meshes;
 };
 
+// The world-frame axis-aligned box around `box` (an object's frame) placed by T_world_object.
+Bounds world_box(const Bounds& box, const SE3& T_world_object) {
+  Bounds world{{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
+  for (const Vec3& corner : box_corners(box)) {
+    const Vec3 w = T_world_object * corner;
+    for (size_t k = 0; k < 3; ++k) {
+      world.min[k] = std::min(world.min[k], w[k]);
+      world.max[k] = std::max(world.max[k], w[k]);
+    }
+  }
+  return world;
+}
+
 }  // namespace
 
 RenderStage::RenderStage(std::shared_ptr<RenderSession> session) : session_(std::move(session)) {}
@@ -550,32 +563,21 @@ const ShadowLookup* RenderStage::shadow_for(FrameContext& ctx, Lighting& lightin
             : fit_shadow_frustum(shadow_light_direction_, virtual_casters, settings_.shadows.receiver_height_m, virtual_margin);
     if (virtual_only) {
       patch = virtual_only->receiver;
-      // The maps are read only on the virtual objects and where their shadows fall: the column of
-      // light over those, across. Along the light they still span every caster, so that a real
-      // one anywhere up the column shades them. A courtyard of proxies would otherwise spread the
-      // map's texels, and with them the shadow filters' reach, over the whole courtyard.
-      // Along it, only as far as the proxies reach into the column (each proxy's clusters,
-      // so that a courtyard's floor adds its patch under the column, not its whole extent): the
-      // PCSS blocker search widens with the depth range.
+      // The maps are read only on the virtual objects and where their shadows fall: across the
+      // light, the column over those (a courtyard of proxies would otherwise spread the map's
+      // texels, and with them the filters' reach, over the whole courtyard). Along it, as far as
+      // the proxies reach into that column, cluster by cluster (a floor adds its patch under the
+      // column, not its whole extent: the PCSS search widens with the depth range), so that a real
+      // caster anywhere up the column still shades them.
       if (!lighting.local) {
         ShadowFrustum narrowed = *virtual_only;
-        for (const UploadedObject& object : proxies_) {
+        for (const UploadedObject& proxy : proxies_) {
           // The receivers too: one beyond the far end would read as lit.
-          if (!(object.casts_shadows || object.shadow_catcher) || !proxy_at_viewpoint(object, ctx.camera.meta.viewpoint))
+          if (!(proxy.casts_shadows || proxy.shadow_catcher) || !proxy_at_viewpoint(proxy, ctx.camera.meta.viewpoint))
             continue;
-          const UploadedObject* proxy = &object;
-          const std::vector<Bounds> whole{proxy->bounds};
-          for (const Bounds& cluster : proxy->cluster_bounds.empty() ? whole : proxy->cluster_bounds) {
-            Bounds world{{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
-            for (const Vec3& corner : box_corners(cluster)) {
-              const Vec3 w = proxy->T_world_object * corner;
-              for (size_t k = 0; k < 3; ++k) {
-                world.min[k] = std::min(world.min[k], w[k]);
-                world.max[k] = std::max(world.max[k], w[k]);
-              }
-            }
-            extend_depth_over(narrowed, world);
-          }
+          if (proxy.cluster_bounds.empty()) extend_depth_over(narrowed, world_box(proxy.bounds, proxy.T_world_object));
+          for (const Bounds& cluster : proxy.cluster_bounds)
+            extend_depth_over(narrowed, world_box(cluster, proxy.T_world_object));
         }
         const double slack = 1e-3 * std::max(narrowed.max[2] - narrowed.min[2], 1e-3);
         narrowed.min[2] -= slack;
@@ -695,17 +697,18 @@ std::optional<PixelRect> RenderStage::shadow_volume_rect(const CameraModel& came
       }
     for (const Vec3& vertex : sweep)
       for (size_t k = 0; k < 4; ++k) edge(vertex + square[k], vertex + square[(k + 1) % 4]);
-    if (settings_.shadows.sky_occlusion) {
+    if (settings_.shadows.sky_occlusion) {  // the ground square it darkens: 2 r about its centre
       const Vec3 centre = object.T_world_object * (0.5 * (object.bounds.min + object.bounds.max));
-      const double r = 2 * object.sky_radius_m;
-      std::array<Vec3, 4> square{};
+      const double half = 2 * object.sky_radius_m;
+      std::array<Vec3, 4> darkened{};
       for (size_t i = 0; i < 4; ++i)
-        square[i] = T_cam_world * Vec3{centre[0] + ((i == 1 || i == 2) ? r : -r), centre[1] + (i >= 2 ? r : -r), h};
-      for (size_t i = 0; i < 4; ++i) append_segment_in_front(points, square[i], square[(i + 1) % 4], kSamples);
+        darkened[i] = Vec3{centre[0] + ((i == 1 || i == 2) ? half : -half), centre[1] + (i >= 2 ? half : -half), h};
+      for (size_t i = 0; i < 4; ++i) edge(darkened[i], darkened[(i + 1) % 4]);
     }
     // Object by object: the hull is convex, their union is not (one beside the camera on the left
     // and one on the right would span the picture). Behind the camera or out of the picture: none.
-    if (const std::optional<PixelRect> r = projected_points_rect(camera, points, kRectMarginPx)) rect = rect.united(*r);
+    if (const std::optional<PixelRect> drawn = projected_points_rect(camera, points, kRectMarginPx))
+      rect = rect.united(*drawn);
   }
   return rect;
 }
