@@ -1,4 +1,4 @@
-// The libc functions the stand-in interposes (open*, close, ioctl, mmap*, poll, read): calls on
+// The libc functions the stand-in interposes (open*, close, dup*, fcntl, ioctl, mmap*, poll, read): calls on
 // served paths and tracked fds go to the registry, everything else to the next definition (libc).
 #undef _FORTIFY_SOURCE  // this file defines open() and friends; fortify would wrap them inline
 
@@ -16,40 +16,26 @@
 #include <cstring>
 #include <string>
 
+#include "next_symbol.h"
 #include "standin_config.h"
 #include "standin_registry.h"
 
 using arpipe::standin::is_serving;
 using arpipe::standin::is_tracked;
+using arpipe::standin::served_at;
 using arpipe::standin::Registry;
 
 namespace {
-
-// The next definition of a libc function, looked up once (dlsym before any constructor is fine).
-template <typename F>
-F next_symbol(std::atomic<F>& slot, const char* name) {
-  F f = slot.load(std::memory_order_acquire);
-  if (f == nullptr) {
-    f = reinterpret_cast<F>(::dlsym(RTLD_NEXT, name));
-    if (f == nullptr) {
-      std::fprintf(stderr, "arpipe-v4l2-standin: cannot find the next %s: %s\n", name, ::dlerror());
-      std::abort();
-    }
-    slot.store(f, std::memory_order_release);
-  }
-  return f;
-}
-#define ARPIPE_REAL(type, name)                       \
-  [] {                                                \
-    static std::atomic<type> slot{nullptr};           \
-    return next_symbol<type>(slot, #name);            \
-  }()
 
 using OpenFn = int (*)(const char*, int, ...);
 using OpenatFn = int (*)(int, const char*, int, ...);
 using Open2Fn = int (*)(const char*, int);
 using Openat2Fn = int (*)(int, const char*, int);
 using CloseFn = int (*)(int);
+using DupFn = int (*)(int);
+using Dup2Fn = int (*)(int, int);
+using Dup3Fn = int (*)(int, int, int);
+using FcntlFn = int (*)(int, int, ...);
 using IoctlFn = int (*)(int, unsigned long, ...);
 using MmapFn = void* (*)(void*, size_t, int, int, int, off_t);
 using PollFn = int (*)(pollfd*, nfds_t, int);
@@ -58,22 +44,6 @@ using ReadFn = ssize_t (*)(int, void*, size_t);
 using ReadChkFn = ssize_t (*)(int, void*, size_t, size_t);
 
 bool wants_mode(int flags) { return (flags & O_CREAT) != 0 || (flags & O_TMPFILE) == O_TMPFILE; }
-
-// The served path that (dirfd, path) names, or "" (cheap while nothing is served).
-std::string served(int dirfd, const char* path) {
-  if (!is_serving() || path == nullptr) return "";
-  std::string full = path;
-  if (full.empty()) return "";
-  if (full[0] != '/' && dirfd != AT_FDCWD) {
-    char link[64], dir[4096];
-    std::snprintf(link, sizeof link, "/proc/self/fd/%d", dirfd);
-    const ssize_t n = ::readlink(link, dir, sizeof dir - 1);
-    if (n <= 0) return "";
-    dir[n] = '\0';
-    full = std::string(dir) + "/" + full;
-  }
-  return Registry::get().served_path(arpipe::standin::normal_device_path(full));
-}
 
 }  // namespace
 
@@ -87,7 +57,7 @@ ARPIPE_EXPORT int open(const char* path, int flags, ...) {
     mode = va_arg(ap, mode_t);
     va_end(ap);
   }
-  if (const std::string s = served(AT_FDCWD, path); !s.empty()) return Registry::get().open(s, flags);
+  if (const std::string s = served_at(AT_FDCWD, path); !s.empty()) return Registry::get().open(s, flags);
   return ARPIPE_REAL(OpenFn, open)(path, flags, mode);
 }
 
@@ -99,7 +69,7 @@ ARPIPE_EXPORT int open64(const char* path, int flags, ...) {
     mode = va_arg(ap, mode_t);
     va_end(ap);
   }
-  if (const std::string s = served(AT_FDCWD, path); !s.empty()) return Registry::get().open(s, flags);
+  if (const std::string s = served_at(AT_FDCWD, path); !s.empty()) return Registry::get().open(s, flags);
   return ARPIPE_REAL(OpenFn, open64)(path, flags, mode);
 }
 
@@ -111,7 +81,7 @@ ARPIPE_EXPORT int openat(int dirfd, const char* path, int flags, ...) {
     mode = va_arg(ap, mode_t);
     va_end(ap);
   }
-  if (const std::string s = served(dirfd, path); !s.empty()) return Registry::get().open(s, flags);
+  if (const std::string s = served_at(dirfd, path); !s.empty()) return Registry::get().open(s, flags);
   return ARPIPE_REAL(OpenatFn, openat)(dirfd, path, flags, mode);
 }
 
@@ -123,26 +93,73 @@ ARPIPE_EXPORT int openat64(int dirfd, const char* path, int flags, ...) {
     mode = va_arg(ap, mode_t);
     va_end(ap);
   }
-  if (const std::string s = served(dirfd, path); !s.empty()) return Registry::get().open(s, flags);
+  if (const std::string s = served_at(dirfd, path); !s.empty()) return Registry::get().open(s, flags);
   return ARPIPE_REAL(OpenatFn, openat64)(dirfd, path, flags, mode);
 }
 
 // The _FORTIFY_SOURCE entry points a host built with fortification calls instead.
 ARPIPE_EXPORT int __open_2(const char* path, int flags) {
-  if (const std::string s = served(AT_FDCWD, path); !s.empty()) return Registry::get().open(s, flags);
+  if (const std::string s = served_at(AT_FDCWD, path); !s.empty()) return Registry::get().open(s, flags);
   return ARPIPE_REAL(Open2Fn, __open_2)(path, flags);
 }
 ARPIPE_EXPORT int __open64_2(const char* path, int flags) {
-  if (const std::string s = served(AT_FDCWD, path); !s.empty()) return Registry::get().open(s, flags);
+  if (const std::string s = served_at(AT_FDCWD, path); !s.empty()) return Registry::get().open(s, flags);
   return ARPIPE_REAL(Open2Fn, __open64_2)(path, flags);
 }
 ARPIPE_EXPORT int __openat_2(int dirfd, const char* path, int flags) {
-  if (const std::string s = served(dirfd, path); !s.empty()) return Registry::get().open(s, flags);
+  if (const std::string s = served_at(dirfd, path); !s.empty()) return Registry::get().open(s, flags);
   return ARPIPE_REAL(Openat2Fn, __openat_2)(dirfd, path, flags);
 }
 ARPIPE_EXPORT int __openat64_2(int dirfd, const char* path, int flags) {
-  if (const std::string s = served(dirfd, path); !s.empty()) return Registry::get().open(s, flags);
+  if (const std::string s = served_at(dirfd, path); !s.empty()) return Registry::get().open(s, flags);
   return ARPIPE_REAL(Openat2Fn, __openat64_2)(dirfd, path, flags);
+}
+
+// Duplicates of a tracked fd share its open file, as dup(2) shares the file description: the real
+// dup of the eventfd is made first, then tracked.
+ARPIPE_EXPORT int dup(int fd) noexcept {
+  const int r = ARPIPE_REAL(DupFn, dup)(fd);
+  if (r >= 0 && is_tracked(fd)) Registry::get().dup(fd, r);
+  return r;
+}
+
+ARPIPE_EXPORT int dup2(int fd, int fd2) noexcept {
+  if (is_tracked(fd2) && fd2 != fd) Registry::get().close(fd2);  // dup2 closes what fd2 was
+  const int r = ARPIPE_REAL(Dup2Fn, dup2)(fd, fd2);
+  if (r >= 0 && is_tracked(fd)) Registry::get().dup(fd, r);
+  return r;
+}
+
+ARPIPE_EXPORT int dup3(int fd, int fd2, int flags) noexcept {
+  if (is_tracked(fd2) && fd2 != fd) Registry::get().close(fd2);
+  const int r = ARPIPE_REAL(Dup3Fn, dup3)(fd, fd2, flags);
+  if (r >= 0 && is_tracked(fd)) Registry::get().dup(fd, r);
+  return r;
+}
+
+namespace {
+// fcntl's third argument is an int or a pointer; a long carries either (as glibc's own wrapper does).
+int forward_fcntl(FcntlFn real, int fd, int cmd, long arg) {
+  const int r = real(fd, cmd, arg);
+  if (r >= 0 && (cmd == F_DUPFD || cmd == F_DUPFD_CLOEXEC) && is_tracked(fd)) Registry::get().dup(fd, r);
+  return r;
+}
+}  // namespace
+
+ARPIPE_EXPORT int fcntl(int fd, int cmd, ...) {
+  va_list ap;
+  va_start(ap, cmd);
+  const long arg = va_arg(ap, long);
+  va_end(ap);
+  return forward_fcntl(ARPIPE_REAL(FcntlFn, fcntl), fd, cmd, arg);
+}
+
+ARPIPE_EXPORT int fcntl64(int fd, int cmd, ...) {
+  va_list ap;
+  va_start(ap, cmd);
+  const long arg = va_arg(ap, long);
+  va_end(ap);
+  return forward_fcntl(ARPIPE_REAL(FcntlFn, fcntl64), fd, cmd, arg);
 }
 
 ARPIPE_EXPORT int close(int fd) {

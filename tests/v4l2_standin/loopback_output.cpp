@@ -39,6 +39,7 @@ const char* loopback_format_description(PixelFormat f) {
     case PixelFormat::RGB24: return "24-bit RGB 8-8-8";
     case PixelFormat::GREY: return "8-bit Greyscale";
     case PixelFormat::NV12: return "Y/UV 4:2:0";
+    default: break;  // a loopback takes only the formats above (standin_config.cpp)
   }
   return "?";
 }

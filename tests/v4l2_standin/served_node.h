@@ -21,7 +21,9 @@ class Node;
 
 // An open file description of a served node (one per tracked fd).
 struct OpenFile {
-  int fd = -1;
+  int fd = -1;         // one of its descriptors (dup()s share the file; this one is open)
+  int descriptors = 1;  // how many tracked descriptors refer to it (dup, dup2, fcntl(F_DUPFD))
+  bool signalled = false;  // the eventfd's counter is non-zero (readable for select/epoll)
   std::shared_ptr<Node> device;
   bool dead = false;  // the device was unplugged or unloaded: ENODEV from now on
   EventQueue events;

@@ -23,6 +23,23 @@ inline constexpr int kMaxTrackedFd = 1 << 16;
 bool is_tracked(int fd);
 // True while some configuration is loaded (so open() has paths to look at).
 bool is_serving();
+// The served path that (dirfd, path) names, following the last component's symlinks, or "" (cheap
+// while nothing is served). Never calls an interposed function, so stat() may use it.
+std::string served_at(int dirfd, const char* path);
+// The served path that (dirfd, path) names itself (no symlink followed: lstat), or "".
+std::string served_exactly_at(int dirfd, const char* path);
+
+// What stat() says of a served node: a character device of the video4linux major.
+inline constexpr unsigned kVideoMajor = 81;
+struct NodeIdentity {
+  unsigned minor = 0;
+  int64_t loaded_at_ns = 0;  // CLOCK_REALTIME of the load: the node's times
+};
+// The identity of a served path or a tracked fd; false when it is not one.
+bool identity_of_path(const std::string& served, NodeIdentity& out);
+bool identity_of_fd(int fd, NodeIdentity& out);
+// The served path whose node has this minor, or "".
+std::string served_path_of_minor(unsigned minor);
 
 class Registry {
  public:
@@ -38,6 +55,9 @@ class Registry {
   int open(const std::string& served, int flags);
   // Untracks fd if it is ours (before the real close).
   void close(int fd);
+  // newfd (a real dup of the tracked oldfd's eventfd) shares oldfd's open file, as dup(2) shares
+  // the file description. Call with newfd already made; a tracked newfd that dup2 replaced is closed first.
+  void dup(int oldfd, int newfd);
   // -1 with errno set, or the ioctl's result; `handled` false when fd is not ours after all.
   int ioctl(int fd, unsigned long request, void* arg, bool& handled);
   void* mmap(int fd, void* addr, size_t length, int prot, int flags, int64_t offset, bool& handled);
@@ -45,8 +65,20 @@ class Registry {
   int poll(pollfd* fds, nfds_t nfds, int timeout_ms, RealPoll real_poll);
 
  private:
+  friend bool identity_of_path(const std::string& served, NodeIdentity& out);
+  friend std::string served_path_of_minor(unsigned minor);
   Registry() = default;
   std::shared_ptr<Node> find_device(const std::string& path) const;
+  // Makes each open file's eventfd readable exactly while poll() would report something for it
+  // (a done buffer, an event, an error), so select() and epoll on the descriptor itself work.
+  void sync_readiness();
+  // The frame clock: a thread (started at the first open) that lets frames fall due on time and
+  // syncs readiness, so a host sleeping in epoll_wait() wakes for them.
+  void start_clock();
+  void run_clock();
+  void fork_prepare();
+  void fork_parent();
+  void fork_child();
 
   std::mutex mutex_;
   std::condition_variable wake_;
@@ -56,6 +88,8 @@ class Registry {
   // opened while it is held).
   std::mutex paths_mutex_;
   std::vector<std::string> paths_;
+  std::vector<NodeIdentity> identities_;  // of paths_, index for index
+  bool clock_running_ = false;
 };
 
 }  // namespace arpipe::standin
