@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstring>
 
+#include "core/image/bayer.h"
+#include "core/image/srgb.h"
 #include "core/image/yuv_rows.h"
 
 namespace arpipe {
@@ -23,6 +25,18 @@ void to_grey(const Frame& f, std::vector<uint8_t>& out) { to_grey(f, PixelRect::
 void to_grey(const Frame& f, const PixelRect& rect, std::vector<uint8_t>& out) {
   out.resize(size_t(f.width) * f.height);
   const PixelRect r = rect.intersected(PixelRect::full(f.width, f.height));
+  if (is_bayer(f.format)) {
+    // Demosaicing needs the neighbours, so the whole frame is developed and the rect's luma taken
+    // from it: the same luma as the frame's RGB24 would give.
+    thread_local std::vector<uint8_t> rgb;
+    bayer_to_rgb24(f, BayerDevelopment{}, rgb);
+    for (int y = r.y; y < r.bottom(); ++y)
+      for (int x = r.x; x < r.right(); ++x) {
+        const uint8_t* p = &rgb[(size_t(y) * f.width + x) * 3];
+        out[size_t(y) * f.width + x] = rgb_to_full_range_luma(p[0], p[1], p[2]);
+      }
+    return;
+  }
   for (int y = r.y; y < r.bottom(); ++y) {
     const uint8_t* row = f.data.data() + size_t(y) * f.bytes_per_line;
     uint8_t* dst = out.data() + size_t(y) * f.width;
@@ -35,11 +49,16 @@ void to_grey(const Frame& f, const PixelRect& rect, std::vector<uint8_t>& out) {
       case PixelFormat::RGB24:
         for (int x = r.x; x < r.right(); ++x) dst[x] = rgb_to_full_range_luma(row[3 * x], row[3 * x + 1], row[3 * x + 2]);
         break;
+      default: break;  // Bayer: above
     }
   }
 }
 
 void to_rgb24(const Frame& f, std::vector<uint8_t>& out) {
+  if (is_bayer(f.format)) {
+    bayer_to_rgb24(f, BayerDevelopment{}, out);
+    return;
+  }
   out.resize(size_t(f.width) * f.height * 3);
   const uint8_t* uv_plane = f.data.data() + f.bytes_per_line * size_t(f.height);
   for (int y = 0; y < f.height; ++y) {
@@ -52,11 +71,31 @@ void to_rgb24(const Frame& f, std::vector<uint8_t>& out) {
         break;
       case PixelFormat::YUYV: yuyv_row_to_rgb24(row, f.width, dst); break;
       case PixelFormat::NV12: nv12_row_to_rgb24(row, uv_plane + size_t(y / 2) * f.bytes_per_line, f.width, dst); break;
+      default: break;  // Bayer: above
     }
   }
 }
 
+namespace {
+// The mosaic a raw sensor with no black level would give of the sRGB image: each pixel's CFA
+// channel decoded to linear and rounded to the format's depth.
+Frame rgb24_to_bayer(const uint8_t* rgb, int width, int height, PixelFormat format) {
+  BayerMosaic mosaic{width, height, *bayer_order(format), bayer_bit_depth(format), {}};
+  mosaic.values.resize(size_t(width) * height);
+  const double top = double((1 << mosaic.bit_depth) - 1);
+  std::array<uint16_t, 256> code{};
+  for (int v = 0; v < 256; ++v) code[size_t(v)] = uint16_t(std::lround(srgb_decode(v / 255.0) * top));
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const size_t i = size_t(y) * width + x;
+      mosaic.values[i] = code[rgb[i * 3 + size_t(mosaic.channel_at(x, y))]];
+    }
+  return pack_bayer(mosaic, format);
+}
+}  // namespace
+
 Frame from_rgb24(const uint8_t* rgb, int width, int height, PixelFormat format) {
+  if (is_bayer(format)) return rgb24_to_bayer(rgb, width, height, format);
   Frame f = Frame::allocate(format, width, height);
   auto px = [&](int x, int y) { return rgb + (size_t(y) * width + x) * 3; };
   for (int y = 0; y < height; ++y) {
@@ -94,6 +133,7 @@ Frame from_rgb24(const uint8_t* rgb, int width, int height, PixelFormat format) 
           }
         }
         break;
+      default: break;  // Bayer: above
     }
   }
   return f;

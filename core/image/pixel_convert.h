@@ -11,15 +11,21 @@
 namespace arpipe {
 
 // Writes width*height bytes of luma (no stride) into out: the Y plane as it is for YUV formats
-// (limited range, 16..235), full-range BT.601 luma for RGB24 and GREY (0..255).
+// (limited range, 16..235), full-range BT.601 luma for RGB24 and GREY (0..255), and for Bayer
+// formats the full-range luma of their RGB24 (below).
 void to_grey(const Frame& frame, std::vector<uint8_t>& out);
 // The same for the pixels of `rect` alone (clipped to the frame), at their places in out, which
 // is sized width*height (its other bytes keep what they held).
 void to_grey(const Frame& frame, const PixelRect& rect, std::vector<uint8_t>& out);
 // Writes width*height*3 bytes of RGB (no stride) into out. BT.601 limited range for YUV formats;
-// GREY is full range (R = G = B = the grey value).
+// GREY is full range (R = G = B = the grey value). Bayer formats are developed by
+// core/image/bayer.h with its defaults (no black level, unit gains, OpenCV's edge-aware
+// demosaicing) and sRGB-encoded; a caller that knows the sensor's black level or white balance
+// calls bayer_to_rgb24 itself.
 void to_rgb24(const Frame& frame, std::vector<uint8_t>& out);
 // Converts a packed RGB24 image (no stride) to the given format, into a new Frame (metadata left default).
+// A Bayer format gets each pixel's CFA channel, sRGB-decoded to linear at the format's depth
+// (black level 0): to_rgb24 gives a flat region back exactly.
 Frame from_rgb24(const uint8_t* rgb, int width, int height, PixelFormat format);
 // Planar 4:2:0 (I420, as Y4M wants it) from packed RGB24 whose rows are rgb_width pixels long:
 // the top-left width x height pixels (both even) become a Y plane, a U plane and a V plane.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstring>
 
+#include "core/image/bayer.h"
 #include "core/image/pixel_convert.h"
 
 namespace arpipe {
@@ -15,6 +16,7 @@ int bytes_per_pixel(PixelFormat f) {
     case PixelFormat::RGB24: return 3;
     case PixelFormat::YUYV: return 2;
     case PixelFormat::NV12: return 1;
+    default: break;  // Bayer: decode_bayer_patch, never cropped
   }
   return 1;
 }
@@ -41,6 +43,31 @@ void crop(const Frame& f, int x0, int y0, int w, int h, Frame& out) {
   }
 }
 
+// Raw sensor values are linear already: the whole frame is developed (demosaicing needs the
+// neighbours of the rect's edge pixels) and the rect taken straight from the linear result, with
+// no response curve and no 8-bit round trip. A pixel is clipped where any channel reaches
+// kRawClippedFrom of the white level.
+constexpr float kRawClippedFrom = 0.98f;
+bool decode_bayer_patch(const Frame& frame, const ImageRect& r, LinearPatch& out) {
+  thread_local std::vector<float> linear;
+  try {
+    develop_bayer(frame, BayerDevelopment{}, linear);
+  } catch (const std::exception&) {
+    return false;  // a frame the format cannot hold: unusable, like a short buffer below
+  }
+  const auto scale = float(out.to_scene_linear);
+  for (int y = 0; y < r.height; ++y) {
+    const float* src = &linear[(size_t(y + r.y0) * size_t(frame.width) + size_t(r.x0)) * 3];
+    float* dst = &out.rgb[size_t(y) * size_t(r.width) * 3];
+    uint8_t* clip = &out.clipped[size_t(y) * size_t(r.width)];
+    for (int x = 0; x < r.width; ++x) {
+      for (int c = 0; c < 3; ++c) dst[3 * x + c] = src[3 * x + c] * scale;
+      clip[x] = std::max({src[3 * x], src[3 * x + 1], src[3 * x + 2]}) >= kRawClippedFrom ? 1 : 0;
+    }
+  }
+  return true;
+}
+
 }  // namespace
 
 bool decode_linear_patch(const Frame& frame, const ImageRect& rect_in, const CameraResponse& response,
@@ -56,6 +83,13 @@ bool decode_linear_patch(const Frame& frame, const ImageRect& rect_in, const Cam
   r.width = x1 - r.x0;
   r.height = y1 - r.y0;
   if (r.empty()) return false;
+  if (is_bayer(frame.format)) {
+    out.rect = r;
+    out.to_scene_linear = 1.0 / (exposure_s * gain);
+    out.rgb.resize(size_t(r.width) * size_t(r.height) * 3);
+    out.clipped.resize(size_t(r.width) * size_t(r.height));
+    return decode_bayer_patch(frame, r, out);
+  }
   // Chroma alignment: YUYV pairs columns, NV12 pairs columns and rows.
   const bool pair_x = frame.format == PixelFormat::YUYV || frame.format == PixelFormat::NV12;
   const bool pair_y = frame.format == PixelFormat::NV12;

@@ -34,6 +34,8 @@ struct LinearPatch {
 // Decodes `rect` (clipped to the image) of any supported format. Only the rectangle is converted
 // (widened to the format's chroma alignment), through the same BT.601 path as to_rgb24. False when
 // the frame, the rectangle or the exposure metadata (exposure_ns > 0, gain > 0) is unusable.
+// Bayer frames are linear already: the whole frame is developed (core/image/bayer.h, defaults) and
+// the rect's values taken without the response curve; clipped at 0.98 of the white level.
 // Never throws; reuses out's buffers.
 bool decode_linear_patch(const Frame& frame, const ImageRect& rect, const CameraResponse& response,
                          LinearPatch& out);
