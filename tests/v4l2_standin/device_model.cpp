@@ -17,7 +17,6 @@ namespace arpipe::standin {
 namespace {
 
 constexpr uint32_t kMaxBuffers = 32;  // VIDEO_MAX_FRAME; uvcvideo's UVC_MAX_VIDEO_BUFFERS
-constexpr uint32_t kCapture = V4L2_BUF_TYPE_VIDEO_CAPTURE;
 
 double max_digital_gain(const FrameSource& source) {
   double g = 0;
@@ -28,6 +27,18 @@ double max_digital_gain(const FrameSource& source) {
 void copy_name(uint8_t* dst, size_t size, const std::string& text) {
   std::memset(dst, 0, size);
   std::memcpy(dst, text.data(), std::min(text.size(), size - 1));
+}
+
+// The ioctls Device::ioctl answers (the rest are ENOTTY).
+bool handles(unsigned long request) {
+  static constexpr unsigned long kHandled[] = {
+      VIDIOC_QUERYCAP, VIDIOC_ENUM_FMT, VIDIOC_ENUM_FRAMESIZES, VIDIOC_ENUM_FRAMEINTERVALS, VIDIOC_G_FMT,
+      VIDIOC_TRY_FMT, VIDIOC_S_FMT, VIDIOC_G_PARM, VIDIOC_S_PARM, VIDIOC_ENUMINPUT, VIDIOC_G_INPUT, VIDIOC_S_INPUT,
+      VIDIOC_REQBUFS, VIDIOC_QUERYBUF, VIDIOC_QBUF, VIDIOC_DQBUF, VIDIOC_STREAMON, VIDIOC_STREAMOFF,
+      VIDIOC_QUERYCTRL, VIDIOC_QUERY_EXT_CTRL, VIDIOC_QUERYMENU, VIDIOC_G_CTRL, VIDIOC_S_CTRL,
+      VIDIOC_G_EXT_CTRLS, VIDIOC_S_EXT_CTRLS, VIDIOC_TRY_EXT_CTRLS, VIDIOC_SUBSCRIBE_EVENT,
+      VIDIOC_UNSUBSCRIBE_EVENT, VIDIOC_DQEVENT};
+  return std::find(std::begin(kHandled), std::end(kHandled), request) != std::end(kHandled);
 }
 
 }  // namespace
@@ -45,6 +56,7 @@ bool blocking_file(const OpenFile& file) {
 
 Device::Device(DeviceConfig config)
     : config_(std::move(config)),
+      type_(config_.buffer_type == BufferType::Mplane ? V4L2_BUF_TYPE_VIDEO_CAPTURE_MPLANE : V4L2_BUF_TYPE_VIDEO_CAPTURE),
       source_(config_),
       controls_(config_.gain_unity, source_.metadata(0), max_digital_gain(source_)),
       faults_(config_.faults) {}
@@ -157,7 +169,18 @@ void Device::deliver(uint64_t g, int64_t at) {
     queued_.pop_front();
     Buffer& b = buffers_[index];
     const OfferedFormat& f = source_.formats()[format_];
-    b.bytes_used = uint32_t(source_.render(i, f, memory_ + size_t(index) * buffer_stride_, buffer_length_));
+    uint8_t* buffer = memory_ + size_t(index) * buffer_stride_;
+    if (num_planes_ == 1) {
+      b.bytes_used = uint32_t(source_.render(i, f, buffer, plane_length_[0]));
+    } else {
+      scratch_.resize(f.size_image);
+      b.bytes_used = uint32_t(source_.render(i, f, scratch_.data(), scratch_.size()));
+      size_t at = 0;
+      for (uint32_t p = 0; p < num_planes_ && b.bytes_used == f.size_image; ++p) {
+        std::memcpy(buffer + plane_offset_[p], scratch_.data() + at, plane_length_[p]);
+        at += plane_length_[p];
+      }
+    }
     b.sequence = sequence_;
     b.timestamp_ns = timestamp(g);
     b.error = error_frame_ == g || b.bytes_used == 0;
@@ -228,7 +251,8 @@ void Device::queue_control_events(const std::vector<ControlChange>& changes, con
 // ---- ioctls ------------------------------------------------------------------------------------
 
 int Device::ioctl(OpenFile& file, unsigned long request, void* arg, const Waiter& wait) {
-  if (arg == nullptr && request != VIDIOC_LOG_STATUS) return EFAULT;
+  // The v4l2 core refuses an ioctl the device lacks (ENOTTY) before it looks at the argument.
+  if (arg == nullptr) return handles(request) ? EFAULT : ENOTTY;
   switch (request) {
     case VIDIOC_QUERYCAP: return querycap(*static_cast<v4l2_capability*>(arg));
     case VIDIOC_ENUM_FMT: return enum_fmt(*static_cast<v4l2_fmtdesc*>(arg));
@@ -236,14 +260,14 @@ int Device::ioctl(OpenFile& file, unsigned long request, void* arg, const Waiter
     case VIDIOC_ENUM_FRAMEINTERVALS: return enum_frameintervals(*static_cast<v4l2_frmivalenum*>(arg));
     case VIDIOC_G_FMT: {
       auto& f = *static_cast<v4l2_format*>(arg);
-      if (f.type != kCapture) return EINVAL;
+      if (f.type != type_) return EINVAL;
       fill_format(format_, f);
       return 0;
     }
     case VIDIOC_TRY_FMT:
     case VIDIOC_S_FMT: {
       auto& f = *static_cast<v4l2_format*>(arg);
-      if (f.type != kCapture) return EINVAL;
+      if (f.type != type_) return EINVAL;
       if (request == VIDIOC_S_FMT) {
         if (busy(file) || !buffers_.empty()) return EBUSY;  // uvcvideo: EBUSY while buffers are allocated
         format_ = adjust_format(f);
@@ -254,7 +278,7 @@ int Device::ioctl(OpenFile& file, unsigned long request, void* arg, const Waiter
     case VIDIOC_G_PARM: return parm(*static_cast<v4l2_streamparm*>(arg));
     case VIDIOC_S_PARM: {
       auto& p = *static_cast<v4l2_streamparm*>(arg);
-      if (p.type != kCapture) return EINVAL;
+      if (p.type != type_) return EINVAL;
       if (busy(file) || streaming_) return EBUSY;  // as uvcvideo
       return parm(p);  // one interval: every request gets it
     }
@@ -273,18 +297,19 @@ int Device::ioctl(OpenFile& file, unsigned long request, void* arg, const Waiter
     case VIDIOC_REQBUFS: return reqbufs(file, *static_cast<v4l2_requestbuffers*>(arg));
     case VIDIOC_QUERYBUF: {
       auto& b = *static_cast<v4l2_buffer*>(arg);
-      if (b.type != kCapture || b.index >= buffers_.size()) return EINVAL;
+      if (b.type != type_ || b.index >= buffers_.size()) return EINVAL;
+      if (mplane() && (b.m.planes == nullptr || b.length < num_planes_)) return EINVAL;
       fill_buffer(b.index, b);
       return 0;
     }
     case VIDIOC_QBUF: return qbuf(file, *static_cast<v4l2_buffer*>(arg));
     case VIDIOC_DQBUF: return dqbuf(file, *static_cast<v4l2_buffer*>(arg), wait);
     case VIDIOC_STREAMON: {
-      if (*static_cast<int*>(arg) != int(kCapture)) return EINVAL;
+      if (*static_cast<int*>(arg) != int(type_)) return EINVAL;
       return streamon(file, monotonic_ns());
     }
     case VIDIOC_STREAMOFF: {
-      if (*static_cast<int*>(arg) != int(kCapture)) return EINVAL;
+      if (*static_cast<int*>(arg) != int(type_)) return EINVAL;
       if (busy(file)) return EBUSY;
       stop_streaming();  // every buffer back to userspace, done ones cleared; the next STREAMON starts at frame 0
       return 0;
@@ -328,19 +353,20 @@ int Device::querycap(v4l2_capability& cap) const {
   copy_name(cap.card, sizeof cap.card, config_.card);
   copy_name(cap.bus_info, sizeof cap.bus_info, config_.bus_info);
   cap.version = LINUX_VERSION_CODE;  // what the kernel's v4l2 core reports
-  cap.device_caps = V4L2_CAP_VIDEO_CAPTURE | V4L2_CAP_STREAMING | V4L2_CAP_EXT_PIX_FORMAT;
+  cap.device_caps = (mplane() ? V4L2_CAP_VIDEO_CAPTURE_MPLANE : V4L2_CAP_VIDEO_CAPTURE) | V4L2_CAP_STREAMING |
+                    V4L2_CAP_EXT_PIX_FORMAT;
   cap.capabilities = cap.device_caps | V4L2_CAP_DEVICE_CAPS;
   return 0;
 }
 
 int Device::enum_fmt(v4l2_fmtdesc& desc) const {
-  if (desc.type != kCapture || desc.index >= source_.formats().size()) return EINVAL;
+  if (desc.type != type_ || desc.index >= source_.formats().size()) return EINVAL;
   const OfferedFormat& f = source_.formats()[desc.index];
   const uint32_t index = desc.index;
   std::memset(&desc, 0, sizeof desc);
   desc.index = index;
-  desc.type = kCapture;
-  desc.flags = f.raw ? 0 : V4L2_FMT_FLAG_COMPRESSED;
+  desc.type = type_;
+  desc.flags = f.fourcc == V4L2_PIX_FMT_MJPEG ? V4L2_FMT_FLAG_COMPRESSED : 0;
   copy_name(desc.description, sizeof desc.description, f.description);
   desc.pixelformat = f.fourcc;
   return 0;
@@ -385,7 +411,24 @@ size_t Device::adjust_format(const v4l2_format& f) const {
 void Device::fill_format(size_t index, v4l2_format& f) const {
   const OfferedFormat& o = source_.formats()[index];
   std::memset(&f.fmt, 0, sizeof f.fmt);
-  f.type = kCapture;
+  f.type = type_;
+  if (mplane()) {
+    v4l2_pix_format_mplane& m = f.fmt.pix_mp;
+    m.width = uint32_t(source_.width());
+    m.height = uint32_t(source_.height());
+    m.pixelformat = o.fourcc;
+    m.field = V4L2_FIELD_NONE;
+    m.colorspace = o.colorspace;
+    m.num_planes = uint8_t(o.num_planes);
+    for (uint32_t i = 0; i < o.num_planes; ++i) {
+      m.plane_fmt[i].bytesperline = o.plane_bytes_per_line[i];
+      m.plane_fmt[i].sizeimage = o.plane_size[i];
+    }
+    m.ycbcr_enc = uint8_t(o.ycbcr_enc);
+    m.quantization = uint8_t(o.quantization);
+    m.xfer_func = uint8_t(o.xfer_func);
+    return;
+  }
   v4l2_pix_format& p = f.fmt.pix;
   p.width = uint32_t(source_.width());
   p.height = uint32_t(source_.height());
@@ -401,7 +444,7 @@ void Device::fill_format(size_t index, v4l2_format& f) const {
 }
 
 int Device::parm(v4l2_streamparm& p) const {
-  if (p.type != kCapture) return EINVAL;
+  if (p.type != type_) return EINVAL;
   std::memset(&p.parm, 0, sizeof p.parm);
   p.parm.capture.capability = V4L2_CAP_TIMEPERFRAME;
   const int64_t gcd = std::gcd(source_.interval_ns(), int64_t(1000000000));
@@ -412,7 +455,7 @@ int Device::parm(v4l2_streamparm& p) const {
 
 int Device::reqbufs(OpenFile& file, v4l2_requestbuffers& r) {
   r.capabilities = V4L2_BUF_CAP_SUPPORTS_MMAP | V4L2_BUF_CAP_SUPPORTS_ORPHANED_BUFS;  // filled even on errors (vb2)
-  if (r.type != kCapture || r.memory != V4L2_MEMORY_MMAP) return EINVAL;
+  if (r.type != type_ || r.memory != V4L2_MEMORY_MMAP) return EINVAL;
   if (busy(file) || streaming_) return EBUSY;
   r.flags = 0;
   std::memset(r.reserved, 0, sizeof r.reserved);
@@ -420,8 +463,15 @@ int Device::reqbufs(OpenFile& file, v4l2_requestbuffers& r) {
   if (r.count == 0) return 0;
   const uint32_t count = std::clamp<uint32_t>(r.count, 1, kMaxBuffers);
   const size_t page = size_t(::sysconf(_SC_PAGESIZE));
-  buffer_length_ = source_.formats()[format_].size_image;
-  buffer_stride_ = (buffer_length_ + page - 1) / page * page;
+  const OfferedFormat& format = source_.formats()[format_];
+  buffer_length_ = format.size_image;
+  num_planes_ = mplane() ? format.num_planes : 1;
+  buffer_stride_ = 0;
+  for (uint32_t i = 0; i < num_planes_; ++i) {
+    plane_length_[i] = mplane() ? format.plane_size[i] : format.size_image;
+    plane_offset_[i] = buffer_stride_;
+    buffer_stride_ += (plane_length_[i] + page - 1) / page * page;
+  }
   memfd_ = ::memfd_create("arpipe-v4l2-standin", MFD_CLOEXEC);
   if (memfd_ < 0) return ENOMEM;
   if (::ftruncate(memfd_, off_t(buffer_stride_ * count)) != 0) {
@@ -442,12 +492,25 @@ int Device::reqbufs(OpenFile& file, v4l2_requestbuffers& r) {
 
 void Device::fill_buffer(uint32_t index, v4l2_buffer& b) const {
   const Buffer& s = buffers_[index];
+  v4l2_plane* planes = mplane() ? b.m.planes : nullptr;  // the caller's array, checked by the caller
   std::memset(&b, 0, sizeof b);
   b.index = index;
-  b.type = kCapture;
+  b.type = type_;
   b.memory = V4L2_MEMORY_MMAP;
-  b.m.offset = uint32_t(size_t(index) * buffer_stride_);
-  b.length = buffer_length_;
+  if (planes != nullptr) {
+    b.m.planes = planes;
+    b.length = num_planes_;
+    for (uint32_t i = 0; i < num_planes_; ++i) {
+      std::memset(&planes[i], 0, sizeof planes[i]);
+      planes[i].length = plane_length_[i];
+      planes[i].m.mem_offset = uint32_t(size_t(index) * buffer_stride_ + plane_offset_[i]);
+      planes[i].bytesused = plane_bytes_used(s, i);
+      planes[i].data_offset = 0;
+    }
+  } else {
+    b.m.offset = uint32_t(size_t(index) * buffer_stride_);
+    b.length = buffer_length_;
+  }
   b.field = V4L2_FIELD_NONE;
   b.flags = V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC |
             (config_.timestamp_source == TimestampSource::StartOfExposure ? V4L2_BUF_FLAG_TSTAMP_SRC_SOE
@@ -466,10 +529,16 @@ void Device::fill_buffer(uint32_t index, v4l2_buffer& b) const {
   }
 }
 
+uint32_t Device::plane_bytes_used(const Buffer& b, uint32_t plane) const {
+  if (num_planes_ == 1) return b.bytes_used;
+  return b.bytes_used == 0 ? 0 : plane_length_[plane];  // a split frame fills every plane whole
+}
+
 int Device::qbuf(OpenFile& file, v4l2_buffer& b) {
-  if (b.type != kCapture || b.memory != V4L2_MEMORY_MMAP) return EINVAL;
+  if (b.type != type_ || b.memory != V4L2_MEMORY_MMAP) return EINVAL;
   if (busy(file)) return EBUSY;
   if (b.index >= buffers_.size()) return EINVAL;
+  if (mplane() && (b.m.planes == nullptr || b.length < num_planes_)) return EINVAL;  // vb2: too few planes
   Buffer& s = buffers_[b.index];
   if (s.queued || s.done) return EINVAL;  // vb2: the buffer is not in dequeued state
   s = Buffer{false, false, s.mapped, false, 0, 0, 0};
@@ -481,8 +550,9 @@ int Device::qbuf(OpenFile& file, v4l2_buffer& b) {
 }
 
 int Device::dqbuf(OpenFile& file, v4l2_buffer& b, const Waiter& wait) {
-  if (b.type != kCapture || b.memory != V4L2_MEMORY_MMAP) return EINVAL;
+  if (b.type != type_ || b.memory != V4L2_MEMORY_MMAP) return EINVAL;
   if (busy(file)) return EBUSY;
+  if (mplane() && (b.m.planes == nullptr || b.length < num_planes_)) return EINVAL;
   const bool may_block = blocking_file(file);
   for (;;) {
     if (file.dead) return EIO;  // vb2 after a disconnect while waiting: the queue is in error state
@@ -632,9 +702,14 @@ void* Device::mmap(void* addr, size_t length, int prot, int flags, int64_t offse
     return MAP_FAILED;
   };
   if ((flags & MAP_SHARED) == 0 || (prot & PROT_READ) == 0) return fail(EINVAL);  // vb2 capture queues
-  if (buffers_.empty() || offset < 0 || size_t(offset) % buffer_stride_ != 0) return fail(EINVAL);
-  const size_t index = size_t(offset) / buffer_stride_;
-  if (index >= buffers_.size() || length == 0 || length > buffer_stride_) return fail(EINVAL);
+  if (buffers_.empty() || offset < 0) return fail(EINVAL);
+  const size_t index = size_t(offset) / buffer_stride_, within = size_t(offset) % buffer_stride_;
+  const size_t page = size_t(::sysconf(_SC_PAGESIZE));
+  uint32_t plane = 0;  // each plane is mapped by its own offset, as vb2 gives it
+  while (plane < num_planes_ && plane_offset_[plane] != within) ++plane;
+  if (index >= buffers_.size() || plane == num_planes_ || length == 0 ||
+      length > (plane_length_[plane] + page - 1) / page * page)
+    return fail(EINVAL);
   void* p = ::mmap(addr, length, prot, flags, memfd_, off_t(offset));
   if (p == MAP_FAILED) return p;
   buffers_[index].mapped = true;

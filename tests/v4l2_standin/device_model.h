@@ -80,7 +80,11 @@ class Device final : public Node {
   void unplug(int64_t at, int64_t replug_after_ns);
   void free_buffers();
 
+  bool mplane() const { return config_.buffer_type == BufferType::Mplane; }
+  uint32_t plane_bytes_used(const Buffer& b, uint32_t plane) const;
+
   DeviceConfig config_;
+  uint32_t type_;  // V4L2_BUF_TYPE_VIDEO_CAPTURE or _MPLANE, from buffer_type
   FrameSource source_;
   ControlTable controls_;
   FaultPlan faults_;
@@ -92,7 +96,13 @@ class Device final : public Node {
   int memfd_ = -1;
   uint8_t* memory_ = nullptr;
   size_t buffer_stride_ = 0;  // page-aligned spacing of the buffers in the memfd (their mmap offsets)
-  uint32_t buffer_length_ = 0;
+  uint32_t buffer_length_ = 0;  // single-planar: the buffer's length
+  // The planes of each buffer (one unless the format is split, multi-planar only): their lengths and
+  // page-aligned offsets within the buffer, so each plane is mapped by its own offset.
+  uint32_t num_planes_ = 1;
+  uint32_t plane_length_[kMaxPlanes] = {};
+  size_t plane_offset_[kMaxPlanes] = {};
+  std::vector<uint8_t> scratch_;  // a split frame is rendered whole, then cut into its planes
   std::vector<Buffer> buffers_;
   std::deque<uint32_t> queued_, done_;
   bool streaming_ = false;

@@ -4,6 +4,7 @@
 #include <linux/videodev2.h>
 #include <turbojpeg.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 
@@ -13,14 +14,24 @@ namespace arpipe::standin {
 
 namespace {
 
-// Format descriptions as the kernel's v4l_fill_fmtdesc words them.
+// Format descriptions as the kernel's v4l_fill_fmtdesc words them, in the words Debian 12's
+// v4l2-compliance (1.22) checks (kernels since 6.0 say "Y/UV" where it says "Y/CbCr").
 const char* description_of(uint32_t fourcc) {
   switch (fourcc) {
     case V4L2_PIX_FMT_YUYV: return "YUYV 4:2:2";
     case V4L2_PIX_FMT_MJPEG: return "Motion-JPEG";
     case V4L2_PIX_FMT_RGB24: return "24-bit RGB 8-8-8";
     case V4L2_PIX_FMT_GREY: return "8-bit Greyscale";
-    case V4L2_PIX_FMT_NV12: return "Y/UV 4:2:0";
+    case V4L2_PIX_FMT_NV12: return "Y/CbCr 4:2:0";
+    case V4L2_PIX_FMT_UYVY: return "UYVY 4:2:2";
+    case V4L2_PIX_FMT_YVYU: return "YVYU 4:2:2";
+    case V4L2_PIX_FMT_NV21: return "Y/CrCb 4:2:0";
+    case V4L2_PIX_FMT_YUV420: return "Planar YUV 4:2:0";
+    case V4L2_PIX_FMT_NV16: return "Y/CbCr 4:2:2";
+    case V4L2_PIX_FMT_NV12M: return "Y/CbCr 4:2:0 (N-C)";
+    case V4L2_PIX_FMT_NV21M: return "Y/CrCb 4:2:0 (N-C)";
+    case V4L2_PIX_FMT_YUV420M: return "Planar YUV 4:2:0 (N-C)";
+    case V4L2_PIX_FMT_NV16M: return "Y/CbCr 4:2:2 (N-C)";
   }
   return "?";
 }
@@ -54,10 +65,58 @@ PixelFormat raw_format(OfferedFormatName format) {
     case OfferedFormatName::Rgb24: return PixelFormat::RGB24;
     case OfferedFormatName::Grey: return PixelFormat::GREY;
     case OfferedFormatName::Nv12: return PixelFormat::NV12;
-    case OfferedFormatName::Native:
-    case OfferedFormatName::Mjpg: break;
+    default: break;
   }
-  return PixelFormat::YUYV;  // not reached: the caller handles Native and Mjpg
+  return PixelFormat::YUYV;  // not reached: the caller handles Native, Mjpg and the derived ones
+}
+
+struct DerivedName {
+  OfferedFormatName name;
+  DerivedLayout layout;
+  uint32_t fourcc;
+  bool split;
+};
+// The formats made by reordering YUYV or NV12 bytes (NV12M is NV12's bytes split, below).
+constexpr DerivedName kDerived[] = {
+    {OfferedFormatName::Uyvy, DerivedLayout::Uyvy, V4L2_PIX_FMT_UYVY, false},
+    {OfferedFormatName::Yvyu, DerivedLayout::Yvyu, V4L2_PIX_FMT_YVYU, false},
+    {OfferedFormatName::Nv16, DerivedLayout::Nv16, V4L2_PIX_FMT_NV16, false},
+    {OfferedFormatName::Nv21, DerivedLayout::Nv21, V4L2_PIX_FMT_NV21, false},
+    {OfferedFormatName::Yu12, DerivedLayout::Yu12, V4L2_PIX_FMT_YUV420, false},
+    {OfferedFormatName::Nv16m, DerivedLayout::Nv16, V4L2_PIX_FMT_NV16M, true},
+    {OfferedFormatName::Nv21m, DerivedLayout::Nv21, V4L2_PIX_FMT_NV21M, true},
+    {OfferedFormatName::Yuv420m, DerivedLayout::Yu12, V4L2_PIX_FMT_YUV420M, true}};
+
+// The planes a format is cut into when served multi-planar: one (the whole image) unless split.
+void set_planes(OfferedFormat& f, bool split, uint32_t width, uint32_t height) {
+  f.num_planes = 1;
+  f.plane_bytes_per_line[0] = f.bytes_per_line;
+  f.plane_size[0] = f.size_image;
+  if (!split) return;
+  const uint32_t y = f.bytes_per_line * height;
+  f.plane_size[0] = y;
+  switch (f.fourcc) {
+    case V4L2_PIX_FMT_NV12M:
+    case V4L2_PIX_FMT_NV21M:
+    case V4L2_PIX_FMT_NV16M:
+      f.num_planes = 2;
+      f.plane_bytes_per_line[1] = f.bytes_per_line;
+      f.plane_size[1] = f.size_image - y;
+      break;
+    case V4L2_PIX_FMT_YUV420M:
+      f.num_planes = 3;
+      f.plane_bytes_per_line[1] = f.plane_bytes_per_line[2] = width / 2;
+      f.plane_size[1] = f.plane_size[2] = (f.size_image - y) / 2;
+      break;
+  }
+}
+
+// A layout's size rules (4:2:2 pairs columns; 4:2:0 also rows), or nullopt when it fits.
+std::optional<std::string> check_derived_size(DerivedLayout layout, int width, int height) {
+  if (width < 2 || height < 2) return "it needs at least 2x2 pixels";
+  if (width % 2 != 0) return "it needs an even width";
+  if (!derived_from_yuyv(layout) && height % 2 != 0) return "it needs an even height";
+  return std::nullopt;
 }
 
 }  // namespace
@@ -78,6 +137,26 @@ FrameSource::FrameSource(const DeviceConfig& config) : config_(config) {
       f = make_format(info.pixel_format, true, info);
     } else if (format == OfferedFormatName::Mjpg) {
       f = make_format(std::nullopt, false, info);
+    } else if (format == OfferedFormatName::Nv12m) {
+      if (const auto bad = check_image_size(PixelFormat::NV12, info.width, info.height))
+        throw StandinConfigError(fmt::format("{}: format {} cannot carry the recording's {}x{} frames: {}",
+                                             config.formats_place, name, info.width, info.height, *bad));
+      f = make_format(PixelFormat::NV12, info.pixel_format == PixelFormat::NV12, info);
+      f.fourcc = V4L2_PIX_FMT_NV12M;
+      f.description = description_of(f.fourcc);
+    } else if (const auto d = std::find_if(std::begin(kDerived), std::end(kDerived),
+                                           [&](const DerivedName& n) { return n.name == format; });
+               d != std::end(kDerived)) {
+      if (const auto bad = check_derived_size(d->layout, info.width, info.height))
+        throw StandinConfigError(fmt::format("{}: format {} cannot carry the recording's {}x{} frames: {}",
+                                             config.formats_place, name, info.width, info.height, *bad));
+      f = make_format(std::nullopt, false, info);
+      f.derived = d->layout;
+      f.fourcc = d->fourcc;
+      f.description = description_of(f.fourcc);
+      f.quantization = V4L2_QUANTIZATION_LIM_RANGE;
+      f.bytes_per_line = uint32_t(derived_from_yuyv(d->layout) && d->layout != DerivedLayout::Nv16 ? info.width * 2 : info.width);
+      f.size_image = uint32_t(derived_bytes(d->layout, info.width, info.height));
     } else {
       const PixelFormat raw = raw_format(format);
       if (const auto bad = check_image_size(raw, info.width, info.height))
@@ -85,6 +164,8 @@ FrameSource::FrameSource(const DeviceConfig& config) : config_(config) {
                                              config.formats_place, name, info.width, info.height, *bad));
       f = make_format(raw, raw == info.pixel_format, info);
     }
+    const bool split = format == OfferedFormatName::Nv12m || multi_planar_only(format);
+    set_planes(f, split, uint32_t(info.width), uint32_t(info.height));
     for (const OfferedFormat& other : formats_)
       if (other.fourcc == f.fourcc)
         throw StandinConfigError(fmt::format("{}: 'formats' offers {} twice (\"native\" is the recording's {})",
@@ -129,6 +210,21 @@ size_t FrameSource::render(size_t index, const OfferedFormat& format, uint8_t* d
   if (format.native) {
     const size_t n = std::min(frame_.data.size(), capacity);
     std::memcpy(dst, frame_.data.data(), n);
+    return n;
+  }
+  if (format.derived) {
+    // The YUYV or NV12 image this device would serve (the recording's own bytes when it is in that
+    // format, else arpipe's conversion), reordered.
+    const PixelFormat basis = derived_from_yuyv(*format.derived) ? PixelFormat::YUYV : PixelFormat::NV12;
+    const size_t n = derived_bytes(*format.derived, frame_.width, frame_.height);
+    if (n > capacity) return 0;
+    if (frame_.format == basis) {
+      derive_layout(*format.derived, frame_.data.data(), frame_.bytes_per_line, frame_.width, frame_.height, dst);
+    } else {
+      to_rgb24(frame_, rgb_);
+      const Frame converted = from_rgb24(rgb_.data(), frame_.width, frame_.height, basis);
+      derive_layout(*format.derived, converted.data.data(), converted.bytes_per_line, frame_.width, frame_.height, dst);
+    }
     return n;
   }
   to_rgb24(frame_, rgb_);

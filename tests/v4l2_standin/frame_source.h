@@ -11,15 +11,23 @@
 
 #include "capture/recording/recording_reader.h"
 #include "standin_config.h"
+#include "yuv_layouts.h"
 
 namespace arpipe::standin {
 
+inline constexpr uint32_t kMaxPlanes = 3;
+
 struct OfferedFormat {
   uint32_t fourcc = 0;
-  std::optional<PixelFormat> raw;  // nullopt: MJPG
+  std::optional<PixelFormat> raw;  // nullopt: MJPG or a derived layout
+  std::optional<DerivedLayout> derived;  // UYVY, YVYU, NV16, NV21, YU12 and their split twins
   bool native = false;             // the recording's own bytes, stride included
   uint32_t bytes_per_line = 0;     // 0 for MJPG
   uint32_t size_image = 0;         // MJPG: the largest JPEG (tjBufSize)
+  // Multi-planar: the image cut into planes, in order (split formats: 2 or 3; the rest: 1 = the whole image).
+  uint32_t num_planes = 1;
+  uint32_t plane_bytes_per_line[kMaxPlanes] = {};
+  uint32_t plane_size[kMaxPlanes] = {};
   uint32_t colorspace = 0, ycbcr_enc = 0, quantization = 0, xfer_func = 0;
   const char* description = "";
 };

@@ -22,9 +22,7 @@ PixelFormat loopback_raw_format(OfferedFormatName name) {
     case OfferedFormatName::Rgb24: return PixelFormat::RGB24;
     case OfferedFormatName::Grey: return PixelFormat::GREY;
     case OfferedFormatName::Nv12: return PixelFormat::NV12;
-    case OfferedFormatName::Yuyv:
-    case OfferedFormatName::Native:
-    case OfferedFormatName::Mjpg: break;  // the config admits raw formats only
+    default: break;  // YUYV; the config admits these raw formats only
   }
   return PixelFormat::YUYV;
 }
@@ -38,7 +36,7 @@ const char* loopback_format_description(PixelFormat f) {
     case PixelFormat::YUYV: return "YUYV 4:2:2";
     case PixelFormat::RGB24: return "24-bit RGB 8-8-8";
     case PixelFormat::GREY: return "8-bit Greyscale";
-    case PixelFormat::NV12: return "Y/UV 4:2:0";
+    case PixelFormat::NV12: return "Y/CbCr 4:2:0";  // v4l2-compliance 1.22's words
     default: break;  // a loopback takes only the formats above (standin_config.cpp)
   }
   return "?";

@@ -87,6 +87,12 @@ DeviceConfig read_device(const TomlSection& s, const std::filesystem::path& base
   d.bus_info = s.string("bus_info", fmt::format("platform:arpipe-standin-{}", index));
   d.formats_place = s.place("formats");
   d.formats = read_formats(s, d.formats);
+  d.buffer_type = s.choice("buffer_type", d.buffer_type, kBufferTypeNames);
+  if (d.buffer_type == BufferType::Single)
+    for (const OfferedFormatName f : d.formats)
+      if (multi_planar_only(f))
+        s.fail_with("formats", fmt::format("format \"{}\" has split planes: it needs buffer_type = \"mplane\"",
+                                           choice_name<OfferedFormatName>(kOfferedFormatNames, f)));
   d.pacing = s.choice("pacing", d.pacing, kPacingNames);
   d.timestamps = s.choice("timestamps", d.timestamps, kTimestampBaseNames);
   d.timestamp_source = s.choice("timestamp_source", d.timestamp_source, kTimestampSourceNames);
@@ -134,7 +140,8 @@ LoopbackConfig read_loopback(const TomlSection& s, const std::filesystem::path& 
   l.bus_info = s.string("bus_info", fmt::format("platform:arpipe-loopback-{}", index));
   l.formats = read_formats(s, l.formats);
   for (const OfferedFormatName f : l.formats)
-    if (f == OfferedFormatName::Native || f == OfferedFormatName::Mjpg)
+    if (f != OfferedFormatName::Yuyv && f != OfferedFormatName::Rgb24 && f != OfferedFormatName::Grey &&
+        f != OfferedFormatName::Nv12)
       s.fail("formats", "an array of raw pixel formats, each one of \"YUYV\", \"RGB24\", \"GREY\", \"NV12\"",
              toml_quoted(std::string(choice_name<OfferedFormatName>(kOfferedFormatNames, f))));
   for (size_t i = 0; i < l.formats.size(); ++i)

@@ -28,10 +28,21 @@ enum class TimestampSource { StartOfExposure, EndOfFrame };
 inline constexpr ChoiceName<TimestampSource> kTimestampSourceNames[] = {{"soe", TimestampSource::StartOfExposure},
                                                                         {"eof", TimestampSource::EndOfFrame}};
 // A format a device offers: the recording's own, JPEG-compressed, or converted to a pixel format.
-enum class OfferedFormatName { Native, Mjpg, Yuyv, Rgb24, Grey, Nv12 };
+// The names ending in M are multi-planar (split planes): only with buffer_type = "mplane".
+enum class OfferedFormatName { Native, Mjpg, Yuyv, Rgb24, Grey, Nv12, Uyvy, Yvyu, Nv21, Yu12, Nv16, Nv12m, Nv21m, Yuv420m, Nv16m };
 inline constexpr ChoiceName<OfferedFormatName> kOfferedFormatNames[] = {
     {"native", OfferedFormatName::Native}, {"MJPG", OfferedFormatName::Mjpg},  {"YUYV", OfferedFormatName::Yuyv},
-    {"RGB24", OfferedFormatName::Rgb24},   {"GREY", OfferedFormatName::Grey}, {"NV12", OfferedFormatName::Nv12}};
+    {"RGB24", OfferedFormatName::Rgb24},   {"GREY", OfferedFormatName::Grey}, {"NV12", OfferedFormatName::Nv12},
+    {"UYVY", OfferedFormatName::Uyvy},     {"YVYU", OfferedFormatName::Yvyu}, {"NV21", OfferedFormatName::Nv21},
+    {"YU12", OfferedFormatName::Yu12},     {"NV16", OfferedFormatName::Nv16}, {"NV12M", OfferedFormatName::Nv12m},
+    {"NV21M", OfferedFormatName::Nv21m},   {"YUV420M", OfferedFormatName::Yuv420m}, {"NV16M", OfferedFormatName::Nv16m}};
+inline bool multi_planar_only(OfferedFormatName f) {
+  return f == OfferedFormatName::Nv12m || f == OfferedFormatName::Nv21m || f == OfferedFormatName::Yuv420m ||
+         f == OfferedFormatName::Nv16m;
+}
+// How buffers are described: single-planar VIDEO_CAPTURE (as UVC) or VIDEO_CAPTURE_MPLANE.
+enum class BufferType { Single, Mplane };
+inline constexpr ChoiceName<BufferType> kBufferTypeNames[] = {{"single", BufferType::Single}, {"mplane", BufferType::Mplane}};
 
 struct DeviceConfig {
   std::string path;                   // absolute and lexically normal
@@ -39,6 +50,7 @@ struct DeviceConfig {
   std::string card = "arpipe V4L2 stand-in";
   std::string bus_info;               // default "platform:arpipe-standin-<index>"
   std::vector<OfferedFormatName> formats = {OfferedFormatName::Native, OfferedFormatName::Mjpg};
+  BufferType buffer_type = BufferType::Single;
   Pacing pacing = Pacing::Realtime;
   TimestampBase timestamps = TimestampBase::Recorded;
   TimestampSource timestamp_source = TimestampSource::StartOfExposure;
