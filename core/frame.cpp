@@ -6,13 +6,15 @@ std::string_view timestamp_meaning_name(TimestampMeaning meaning) {
   switch (meaning) {
     case TimestampMeaning::StartOfExposure: return "start_of_exposure";
     case TimestampMeaning::EndOfFrame: return "end_of_frame";
+    case TimestampMeaning::EndOfExposure: return "end_of_exposure";
     case TimestampMeaning::Sensor: return "sensor";
   }
   return "?";
 }
 
 bool timestamp_meaning_from_name(std::string_view name, TimestampMeaning& out) {
-  for (auto m : {TimestampMeaning::StartOfExposure, TimestampMeaning::EndOfFrame, TimestampMeaning::Sensor}) {
+  for (auto m : {TimestampMeaning::StartOfExposure, TimestampMeaning::EndOfFrame, TimestampMeaning::EndOfExposure,
+                 TimestampMeaning::Sensor}) {
     if (timestamp_meaning_name(m) == name) {
       out = m;
       return true;
@@ -26,6 +28,8 @@ int64_t exposure_start_from_raw(int64_t raw_ns, TimestampMeaning meaning, int64_
   int64_t start = raw_ns;
   // End of frame is when the last row finished: it started exposing readout_ns after the first row.
   if (meaning == TimestampMeaning::EndOfFrame) start = raw_ns - exposure_ns - readout_ns;
+  // The first row's end of exposure: it started exposure_ns before.
+  if (meaning == TimestampMeaning::EndOfExposure) start = raw_ns - exposure_ns;
   return start + offset_ns;
 }
 

@@ -18,6 +18,7 @@ namespace arpipe {
 enum class TimestampMeaning {
   StartOfExposure,  // first row started exposing (libcamera SensorTimestamp, V4L2 SOE)
   EndOfFrame,       // last row was read out (V4L2 EOF, most UVC drivers)
+  EndOfExposure,    // first row stopped exposing, i.e. its readout began (Raspberry Pi's SensorTimestamp, reportedly)
   Sensor,           // sensor-defined; treated as start of exposure plus the configured offset
 };
 std::string_view timestamp_meaning_name(TimestampMeaning meaning);

@@ -6,6 +6,7 @@
 #include <optional>
 #include <string>
 
+#include "core/config/source_choices.h"
 #include "core/frame.h"
 
 namespace arpipe {
@@ -29,6 +30,9 @@ struct LibcameraTiming {
   int64_t manual_exposure_us = 0;      // source.exposure_us; 0: auto
   double manual_gain = 0;              // source.gain; 0: auto
   int64_t nominal_frame_duration_ns = 0;  // from source.fps; 0: not configured
+  // source.timestamp_meaning: what SensorTimestamp means on this board (auto: as documented, the
+  // first row's start of exposure; Raspberry Pi's pipeline is said to stamp its end).
+  BufferTimestamps sensor_timestamp = BufferTimestamps::DriverFlag;
 };
 LibcameraTiming libcamera_timing(int64_t timestamp_offset_ns, int64_t readout_ns, int64_t exposure_us,
                                  double gain, double fps);

@@ -179,6 +179,7 @@ void LibcameraStream::open(const SourceConfig& config) {
     throw CameraError(Kind::Refused, fmt::format("libcamera camera '{}': {}", camera_id_, join(start.refused, "; ")));
   for (const auto& note : start.notes) log::warn("libcamera camera '{}': {}", camera_id_, note);
   timing_ = libcamera_timing(config.timestamp_offset_ns, config.readout_ns, config.exposure_us, config.gain, config.fps);
+  timing_.sensor_timestamp = config.timestamp_meaning;
 
   ret = camera_->start(&start.controls);
   if (ret < 0)

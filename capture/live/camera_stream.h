@@ -58,6 +58,11 @@ struct StreamCounters {
   // and copying or decoding it into the Frame with its metadata.
   int64_t dequeue_ns = 0;
   int64_t convert_ns = 0;
+  // Passes over a frame's bytes from the driver's buffer into the Frame (one a frame on a copying
+  // path; MJPEG's decode is not counted), and frames whose memory had to be allocated because the
+  // Frame handed in held too little (none in steady state once frames are recycled).
+  uint64_t copies = 0;
+  uint64_t frame_allocations = 0;
 };
 
 class CameraStream {

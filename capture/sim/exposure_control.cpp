@@ -69,6 +69,7 @@ FrameMetadata simulated_frame_metadata(const SimCamera& camera, uint64_t sequenc
   // end-of-frame stamp comes after the last row's exposure. Sensor stamps act as start of exposure.
   int64_t raw = meta.exposure_start_ns - camera.timestamp_offset_ns;
   if (camera.timestamp_meaning == TimestampMeaning::EndOfFrame) raw += setting.exposure_ns + camera.readout_ns;
+  if (camera.timestamp_meaning == TimestampMeaning::EndOfExposure) raw += setting.exposure_ns;
   meta.raw_timestamp_ns = raw;
   return meta;
 }

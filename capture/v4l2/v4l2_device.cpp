@@ -71,7 +71,15 @@ int V4L2Device::ioctl(unsigned long request, void* arg) const noexcept {
 }
 
 bool V4L2Device::can_capture() const {
-  return (device_caps_ & V4L2_CAP_VIDEO_CAPTURE) && (device_caps_ & V4L2_CAP_STREAMING);
+  return (device_caps_ & (V4L2_CAP_VIDEO_CAPTURE | V4L2_CAP_VIDEO_CAPTURE_MPLANE)) && (device_caps_ & V4L2_CAP_STREAMING);
+}
+
+bool V4L2Device::multi_planar() const {
+  return !(device_caps_ & V4L2_CAP_VIDEO_CAPTURE) && (device_caps_ & V4L2_CAP_VIDEO_CAPTURE_MPLANE);
+}
+
+uint32_t V4L2Device::buffer_type() const {
+  return multi_planar() ? V4L2_BUF_TYPE_VIDEO_CAPTURE_MPLANE : V4L2_BUF_TYPE_VIDEO_CAPTURE;
 }
 
 namespace {
@@ -106,7 +114,7 @@ std::vector<V4L2FormatOffer> V4L2Device::enumerate_formats() const {
   for (uint32_t index = 0;; ++index) {
     v4l2_fmtdesc desc{};
     desc.index = index;
-    desc.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+    desc.type = buffer_type();
     if (ioctl(VIDIOC_ENUM_FMT, &desc) != 0) break;
     V4L2FormatOffer offer;
     offer.fourcc = desc.pixelformat;

@@ -50,9 +50,14 @@ class V4L2Device {
   std::string card() const { return card_; }
   std::string bus_info() const { return bus_info_; }
   uint32_t device_caps() const { return device_caps_; }
-  bool can_capture() const;  // single-planar video capture with streaming I/O
+  bool can_capture() const;  // video capture (single- or multi-planar) with streaming I/O
+  // V4L2_BUF_TYPE_VIDEO_CAPTURE, or VIDEO_CAPTURE_MPLANE for a device that only captures
+  // multi-planar (many MIPI receivers and ISPs: Rockchip, i.MX); every format, buffer and stream
+  // ioctl then takes that type.
+  uint32_t buffer_type() const;
+  bool multi_planar() const;
 
-  // Every format with its sizes and their frame intervals (ENUM_FMT, ENUM_FRAMESIZES,
+  // Every format of buffer_type() with its sizes and their frame intervals (ENUM_FMT, ENUM_FRAMESIZES,
   // ENUM_FRAMEINTERVALS). Non-throwing: a driver that lists nothing gives an empty list.
   std::vector<V4L2FormatOffer> enumerate_formats() const;
 

@@ -8,6 +8,7 @@
 #include <fmt/ranges.h>
 
 #include "capture/live/camera_stream.h"
+#include "capture/v4l2/v4l2_frame_layout.h"
 #include "core/pixel_format.h"
 
 namespace arpipe {
@@ -16,12 +17,14 @@ bool is_mjpeg_fourcc(uint32_t fourcc) { return fourcc == V4L2_PIX_FMT_MJPEG || f
 
 bool same_rate(double fps, double wanted_fps) { return std::abs(fps - wanted_fps) <= 0.005 * wanted_fps; }
 
-bool is_usable_fourcc(uint32_t fourcc) { return is_mjpeg_fourcc(fourcc) || pixel_format_from_fourcc(fourcc).has_value(); }
+bool is_usable_fourcc(uint32_t fourcc) { return is_mjpeg_fourcc(fourcc) || v4l2_frame_layout(fourcc).has_value(); }
 
 namespace {
 
 std::string format_name(uint32_t fourcc) {
   if (is_mjpeg_fourcc(fourcc)) return "MJPG";
+  if (const auto layout = v4l2_frame_layout(fourcc); layout && layout->name != CaptureFormat::Auto)
+    return std::string(choice_name(kCaptureFormatNames, layout->name));
   if (const auto format = pixel_format_from_fourcc(fourcc)) return std::string(pixel_format_name(*format));
   return fourcc_text(fourcc);
 }
@@ -29,7 +32,14 @@ std::string format_name(uint32_t fourcc) {
 bool format_matches(uint32_t fourcc, CaptureFormat wanted) {
   if (wanted == CaptureFormat::Auto) return is_usable_fourcc(fourcc);
   if (wanted == CaptureFormat::MJPG) return is_mjpeg_fourcc(fourcc);
-  return pixel_format_from_fourcc(fourcc) == frame_format(wanted);
+  return fourcc == capture_format_fourcc(wanted);
+}
+
+// Auto's order: formats passed on as they are, then those reordered while copying, then MJPEG.
+int auto_pass(uint32_t fourcc) {
+  if (is_mjpeg_fourcc(fourcc)) return 2;
+  const auto layout = v4l2_frame_layout(fourcc);
+  return layout && layout->kind == V4L2FrameLayout::Kind::AsIs ? 0 : 1;
 }
 
 bool size_matches(const V4L2FrameSize& size, const V4L2FormatRequest& request) {
@@ -81,11 +91,11 @@ std::string describe_v4l2_offers(const std::vector<V4L2FormatOffer>& offers) {
 
 V4L2FormatChoice choose_v4l2_format(const std::vector<V4L2FormatOffer>& offers, const V4L2FormatRequest& request,
                                     const std::string& device) {
-  // Two passes for "auto": formats passed on as they are first, then MJPEG.
-  for (int pass = 0; pass < 2; ++pass) {
+  // Three passes for "auto" (auto_pass); one otherwise.
+  for (int pass = 0; pass < 3; ++pass) {
     for (const auto& offer : offers) {
       if (!format_matches(offer.fourcc, request.pixel_format)) continue;
-      if (request.pixel_format == CaptureFormat::Auto && is_mjpeg_fourcc(offer.fourcc) != (pass == 1)) continue;
+      if (request.pixel_format == CaptureFormat::Auto && auto_pass(offer.fourcc) != pass) continue;
       for (const auto& size : offer.sizes) {
         if (!size_matches(size, request)) continue;
         bool ok = false;

@@ -29,12 +29,13 @@ struct V4L2FormatChoice {
 // 333333/10000000 depending on the driver).
 bool same_rate(double fps, double wanted_fps);
 
-// FourCCs arpipe can take: its own pixel formats, and MJPEG (decoded to RGB24).
+// FourCCs arpipe can take: its own pixel formats, those it reorders into one (v4l2_frame_layout.h),
+// and MJPEG (decoded to RGB24).
 bool is_usable_fourcc(uint32_t fourcc);
 bool is_mjpeg_fourcc(uint32_t fourcc);  // 'MJPG' or 'JPEG'
 
-// The first offer that satisfies the request. Auto prefers a format passed on as it is over
-// MJPEG (decoding costs), in the camera's order; rates match by same_rate(). Throws CameraError(Refused)
+// The first offer that satisfies the request. Auto prefers a format passed on as it is, then one
+// reordered while copying, then MJPEG (decoding costs), each in the camera's order; rates match by same_rate(). Throws CameraError(Refused)
 // naming `device` and listing every usable offer when nothing fits.
 V4L2FormatChoice choose_v4l2_format(const std::vector<V4L2FormatOffer>& offers, const V4L2FormatRequest& request,
                                     const std::string& device);

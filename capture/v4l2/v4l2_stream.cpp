@@ -15,6 +15,7 @@
 
 #include "capture/v4l2/mjpeg_decoder.h"
 #include "capture/v4l2/v4l2_device.h"
+#include "capture/v4l2/v4l2_frame_layout.h"
 #include "capture/v4l2/v4l2_mmap_buffers.h"
 #include "core/log.h"
 #include "core/pipeline/monotonic_clock.h"
@@ -41,8 +42,15 @@ int64_t timeval_ns(const timeval& tv) { return int64_t(tv.tv_sec) * 1'000'000'00
 TimestampMeaning timestamp_meaning(uint32_t flags, BufferTimestamps configured) {
   if (configured == BufferTimestamps::StartOfExposure) return TimestampMeaning::StartOfExposure;
   if (configured == BufferTimestamps::EndOfFrame) return TimestampMeaning::EndOfFrame;
+  if (configured == BufferTimestamps::EndOfExposure) return TimestampMeaning::EndOfExposure;
   return (flags & V4L2_BUF_FLAG_TSTAMP_SRC_MASK) == V4L2_BUF_FLAG_TSTAMP_SRC_SOE ? TimestampMeaning::StartOfExposure
                                                                                  : TimestampMeaning::EndOfFrame;
+}
+
+// "UYVY", "NV12M": the config's name for the camera's format, else its FourCC.
+std::string describe_layout(const V4L2FrameLayout& layout, uint32_t fourcc) {
+  if (layout.name != CaptureFormat::Auto) return std::string(choice_name(kCaptureFormatNames, layout.name));
+  return fourcc_text(fourcc);
 }
 
 // The status for a failed DQBUF or a poll error: a vanished or broken device is Gone (the source
@@ -65,12 +73,12 @@ class V4L2Stream final : public CameraStream {
     if (choice.interval) set_interval(*choice.interval, offers);
     read_interval();
     controls_.emplace(device_, settings.exposure);
-    buffers_.emplace(device_, settings.buffers);
+    buffers_.emplace(device_, settings.buffers, memory_planes_);
     for (uint32_t i = 0; i < buffers_->count(); ++i)
       if (const int err = buffers_->queue(i); err != 0) fail("VIDIOC_QBUF", err);
     wake_fd_ = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
     if (wake_fd_ < 0) fail("eventfd", errno);
-    int type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+    int type = int(device_.buffer_type());
     if (const int err = device_.ioctl(VIDIOC_STREAMON, &type); err != 0) {
       ::close(wake_fd_);
       fail("VIDIOC_STREAMON", err);
@@ -81,7 +89,7 @@ class V4L2Stream final : public CameraStream {
 
   ~V4L2Stream() override {
     if (streaming_) {
-      int type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+      int type = int(device_.buffer_type());
       device_.ioctl(VIDIOC_STREAMOFF, &type);
     }
     buffers_.reset();  // before the device closes
@@ -148,34 +156,50 @@ class V4L2Stream final : public CameraStream {
   }
 
   void set_format(const V4L2FormatChoice& choice, const std::vector<V4L2FormatOffer>& offers) {
+    const bool mplane = device_.multi_planar();
     v4l2_format f{};
-    f.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-    f.fmt.pix.pixelformat = choice.fourcc;
-    f.fmt.pix.width = choice.width;
-    f.fmt.pix.height = choice.height;
-    f.fmt.pix.field = V4L2_FIELD_NONE;
+    f.type = device_.buffer_type();
+    if (mplane) {
+      f.fmt.pix_mp.pixelformat = choice.fourcc;
+      f.fmt.pix_mp.width = choice.width;
+      f.fmt.pix_mp.height = choice.height;
+      f.fmt.pix_mp.field = V4L2_FIELD_NONE;
+    } else {
+      f.fmt.pix.pixelformat = choice.fourcc;
+      f.fmt.pix.width = choice.width;
+      f.fmt.pix.height = choice.height;
+      f.fmt.pix.field = V4L2_FIELD_NONE;
+    }
     if (const int err = device_.ioctl(VIDIOC_S_FMT, &f); err != 0) fail("VIDIOC_S_FMT", err);
+    const uint32_t got_fourcc = mplane ? f.fmt.pix_mp.pixelformat : f.fmt.pix.pixelformat;
+    const uint32_t got_width = mplane ? f.fmt.pix_mp.width : f.fmt.pix.width;
+    const uint32_t got_height = mplane ? f.fmt.pix_mp.height : f.fmt.pix.height;
     // Drivers adjust rather than fail: check what they made of it.
-    if (f.fmt.pix.pixelformat != choice.fourcc || f.fmt.pix.width != choice.width || f.fmt.pix.height != choice.height)
+    if (got_fourcc != choice.fourcc || got_width != choice.width || got_height != choice.height)
       throw CameraError(CameraError::Kind::Refused,
                         fmt::format("{}: asked for {} {}x{}, the driver set {} {}x{}; the camera offers:\n{}",
                                     settings_.device, fourcc_text(choice.fourcc), choice.width, choice.height,
-                                    fourcc_text(f.fmt.pix.pixelformat), f.fmt.pix.width, f.fmt.pix.height,
-                                    describe_v4l2_offers(offers)));
+                                    fourcc_text(got_fourcc), got_width, got_height, describe_v4l2_offers(offers)));
     mjpeg_ = is_mjpeg_fourcc(choice.fourcc);
-    format_.camera_format = mjpeg_ ? "MJPG" : std::string(pixel_format_name(*pixel_format_from_fourcc(choice.fourcc)));
-    format_.format = mjpeg_ ? PixelFormat::RGB24 : *pixel_format_from_fourcc(choice.fourcc);
-    format_.width = int(f.fmt.pix.width);
-    format_.height = int(f.fmt.pix.height);
-    bytes_per_line_ = mjpeg_ ? 0 : f.fmt.pix.bytesperline;
-    if (!mjpeg_ && bytes_per_line_ < min_bytes_per_line(format_.format, format_.width))
-      bytes_per_line_ = min_bytes_per_line(format_.format, format_.width);
+    if (!mjpeg_) layout_ = *v4l2_frame_layout(choice.fourcc);  // the choice is a usable FourCC
+    const uint32_t planes = mplane ? f.fmt.pix_mp.num_planes : 1;
+    if (planes < 1 || planes > VIDEO_MAX_PLANES || (!mjpeg_ && planes != uint32_t(layout_.memory_planes)))
+      throw CameraError(CameraError::Kind::Refused,
+                        fmt::format("{}: the driver gives {} with {} memory planes; arpipe takes it with {}",
+                                    settings_.device, fourcc_text(got_fourcc), planes, mjpeg_ ? 1 : layout_.memory_planes));
+    memory_planes_ = planes;
+    for (uint32_t p = 0; p < planes; ++p)
+      bytes_per_line_[p] = mplane ? f.fmt.pix_mp.plane_fmt[p].bytesperline : f.fmt.pix.bytesperline;
+    format_.camera_format = mjpeg_ ? "MJPG" : describe_layout(layout_, got_fourcc);
+    format_.format = mjpeg_ ? PixelFormat::RGB24 : layout_.frame_format;
+    format_.width = int(got_width);
+    format_.height = int(got_height);
     if (mjpeg_) decoder_.emplace();
   }
 
   void set_interval(const V4L2Fraction& interval, const std::vector<V4L2FormatOffer>& offers) {
     v4l2_streamparm parm{};
-    parm.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+    parm.type = device_.buffer_type();
     if (device_.ioctl(VIDIOC_G_PARM, &parm) != 0 || !(parm.parm.capture.capability & V4L2_CAP_TIMEPERFRAME)) {
       if (settings_.request.fps > 0)
         throw CameraError(CameraError::Kind::Refused,
@@ -194,7 +218,7 @@ class V4L2Stream final : public CameraStream {
 
   void read_interval() {
     v4l2_streamparm parm{};
-    parm.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+    parm.type = device_.buffer_type();
     if (device_.ioctl(VIDIOC_G_PARM, &parm) == 0 && (parm.parm.capture.capability & V4L2_CAP_TIMEPERFRAME)) {
       const V4L2Fraction interval{parm.parm.capture.timeperframe.numerator, parm.parm.capture.timeperframe.denominator};
       format_.frame_interval_ns = interval.ns();
@@ -205,7 +229,11 @@ class V4L2Stream final : public CameraStream {
     const std::string rate = format_.frame_interval_ns > 0
                                  ? fmt::format(" @ {:.4g} fps", 1e9 / double(format_.frame_interval_ns))
                                  : "";
-    const std::string decoded = mjpeg_ ? " (decoded to RGB24)" : "";
+    const std::string decoded =
+        mjpeg_ ? " (decoded to RGB24)"
+               : layout_.kind != V4L2FrameLayout::Kind::AsIs
+                     ? fmt::format(" (reordered to {} as it is copied)", pixel_format_name(layout_.frame_format))
+                     : "";
     return fmt::format("{} {}x{}{}{}, {} buffers", format_.camera_format, format_.width, format_.height, rate, decoded,
                        buffers_->count());
   }
@@ -216,9 +244,14 @@ class V4L2Stream final : public CameraStream {
   }
 
   StreamStatus dequeue(Frame& frame, std::string& why) {
+    v4l2_plane planes[VIDEO_MAX_PLANES] = {};
     v4l2_buffer buffer{};
-    buffer.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+    buffer.type = device_.buffer_type();
     buffer.memory = V4L2_MEMORY_MMAP;
+    if (device_.multi_planar()) {
+      buffer.m.planes = planes;
+      buffer.length = memory_planes_;
+    }
     const int64_t t0 = monotonic_now_ns();
     if (const int err = device_.ioctl(VIDIOC_DQBUF, &buffer); err != 0) {
       if (err == EAGAIN) count([](StreamCounters& c) { ++c.again; });
@@ -252,27 +285,36 @@ class V4L2Stream final : public CameraStream {
                         buffer.sequence);
       return StreamStatus::Again;
     }
-    const uint8_t* data = buffers_->data(buffer.index);
-    const size_t used = std::min<size_t>(buffer.bytesused, buffers_->length(buffer.index));
+    // Each memory plane as the driver filled it (a multi-planar buffer says per plane, after any
+    // data_offset of its own).
+    V4L2Plane in[VIDEO_MAX_PLANES];
+    for (uint32_t p = 0; p < memory_planes_; ++p) {
+      const size_t length = buffers_->length(buffer.index, p);
+      size_t used = std::min<size_t>(buffer.bytesused, length), offset = 0;
+      if (device_.multi_planar()) {
+        used = std::min<size_t>(buffer.m.planes[p].bytesused, length);
+        offset = std::min<size_t>(buffer.m.planes[p].data_offset, used);
+      }
+      in[p] = {buffers_->data(buffer.index, p) + offset, used - offset, bytes_per_line_[p]};
+    }
+    bool allocated = false;
     if (mjpeg_) {
-      if (!decoder_->decode(data, used, format_.width, format_.height, frame, why)) {
+      allocated = frame.data.capacity() < size_t(format_.width) * size_t(format_.height) * 3;
+      if (!decoder_->decode(in[0].data, in[0].bytes_used, format_.width, format_.height, frame, why)) {
         count([](StreamCounters& c) { ++c.error_buffers; });
         why = fmt::format("{}: sequence {}: {}", settings_.device, buffer.sequence, why);
         return StreamStatus::Again;
       }
     } else {
-      const size_t bytes = image_bytes(format_.format, format_.width, format_.height, bytes_per_line_);
-      if (used < bytes) {
+      if (!fill_frame_from_v4l2(layout_, std::span(in, memory_planes_), format_.width, format_.height, frame,
+                                allocated, why)) {
         count([](StreamCounters& c) { ++c.error_buffers; });
-        why = fmt::format("{}: sequence {}: {} bytes, a frame needs {}", settings_.device, buffer.sequence, used, bytes);
+        why = fmt::format("{}: sequence {}: {}", settings_.device, buffer.sequence, why);
         return StreamStatus::Again;
       }
-      frame.format = format_.format;
-      frame.width = format_.width;
-      frame.height = format_.height;
-      frame.bytes_per_line = bytes_per_line_;
-      frame.data.assign(data, data + bytes);
+      count([](StreamCounters& c) { ++c.copies; });
     }
+    if (allocated) count([](StreamCounters& c) { ++c.frame_allocations; });
     if ((buffer.flags & V4L2_BUF_FLAG_TIMESTAMP_MASK) != V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC && !warned_clock_) {
       log::warn("{}: buffer timestamps are not on CLOCK_MONOTONIC (flags {:#x}); used as they are", settings_.device,
                 buffer.flags);
@@ -298,7 +340,9 @@ class V4L2Stream final : public CameraStream {
   V4L2StreamSettings settings_;
   V4L2Device device_;
   StreamFormat format_;
-  size_t bytes_per_line_ = 0;
+  V4L2FrameLayout layout_;
+  uint32_t memory_planes_ = 1;
+  size_t bytes_per_line_[VIDEO_MAX_PLANES] = {};
   bool mjpeg_ = false;
   std::optional<MjpegDecoder> decoder_;
   std::optional<V4L2ExposureControls> controls_;

@@ -95,7 +95,7 @@ void visit(V& v, SourceConfig& s) {
   v.key("gain", s.gain, NumberRange::at_least(0), "manual analogue gain (1 = unity); 0 = auto");
   v.key("gain_unity", s.gain_unity, NumberRange::above(0), "v4l2: the gain control value that means gain 1");
   v.key("timestamp_meaning", s.timestamp_meaning, kBufferTimestampsNames,
-        "v4l2: what buffer timestamps mean when the driver does not say; auto: the driver's flag");
+        "live: what the camera's timestamps mean; auto: V4L2's flag, libcamera's documented start of exposure");
   v.key("readout_ns", s.readout_ns, IntRange{0, 1'000'000'000}, "rolling-shutter readout time; 0 = global shutter");
   v.key("frame_timeout_ms", s.frame_timeout_ms, IntRange{1, 600'000}, "a frame later than this is a timeout");
   v.key("reconnect_min_ms", s.reconnect_min_ms, IntRange{1, 600'000}, "first retry after the camera went away");

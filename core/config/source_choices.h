@@ -30,31 +30,38 @@ inline constexpr ChoiceName<StreamRole> kStreamRoleNames[] = {{"video", StreamRo
                                                               {"raw", StreamRole::Raw}};
 
 // The pixel format asked of a live camera (source.pixel_format): a frame format, MJPG (decoded to
-// RGB24 by the V4L2 source) or Auto (what the camera offers first).
-enum class CaptureFormat { Auto, YUYV, NV12, RGB24, GREY, MJPG };
+// RGB24 by the V4L2 source), a V4L2 format the V4L2 source reorders into a frame format as it copies
+// (UYVY, YVYU, NV16 -> YUYV; NV21, YUV420 -> NV12; the "M" ones are their split-plane twins, named
+// as V4L2_PIX_FMT_*), or Auto (what the camera offers first, formats taken as they are first).
+enum class CaptureFormat { Auto, YUYV, NV12, RGB24, GREY, MJPG, UYVY, YVYU, NV21, YUV420, NV16, NV12M, NV21M, YUV420M, NV16M };
 inline constexpr ChoiceName<CaptureFormat> kCaptureFormatNames[] = {
-    {"auto", CaptureFormat::Auto}, {"YUYV", CaptureFormat::YUYV},   {"NV12", CaptureFormat::NV12},
-    {"RGB24", CaptureFormat::RGB24}, {"GREY", CaptureFormat::GREY}, {"MJPG", CaptureFormat::MJPG}};
+    {"auto", CaptureFormat::Auto},     {"YUYV", CaptureFormat::YUYV},   {"NV12", CaptureFormat::NV12},
+    {"RGB24", CaptureFormat::RGB24},   {"GREY", CaptureFormat::GREY},   {"MJPG", CaptureFormat::MJPG},
+    {"UYVY", CaptureFormat::UYVY},     {"YVYU", CaptureFormat::YVYU},   {"NV21", CaptureFormat::NV21},
+    {"YUV420", CaptureFormat::YUV420}, {"NV16", CaptureFormat::NV16},   {"NV12M", CaptureFormat::NV12M},
+    {"NV21M", CaptureFormat::NV21M},   {"YUV420M", CaptureFormat::YUV420M}, {"NV16M", CaptureFormat::NV16M}};
 
-// The frame format a CaptureFormat names; nullopt for Auto and MJPG (no frame format of their own).
+// The frame format a CaptureFormat names; nullopt for Auto, MJPG and the V4L2-only formats.
 inline std::optional<PixelFormat> frame_format(CaptureFormat format) {
   switch (format) {
     case CaptureFormat::YUYV: return PixelFormat::YUYV;
     case CaptureFormat::NV12: return PixelFormat::NV12;
     case CaptureFormat::RGB24: return PixelFormat::RGB24;
     case CaptureFormat::GREY: return PixelFormat::GREY;
-    case CaptureFormat::Auto:
-    case CaptureFormat::MJPG: return std::nullopt;
+    default: return std::nullopt;  // Auto, MJPG and the formats only the V4L2 source reorders
   }
   return std::nullopt;
 }
 
-// What V4L2 buffer timestamps mean (source.timestamp_meaning): the driver's TSTAMP_SRC flag
-// (DriverFlag, "auto"), or a fixed meaning for drivers whose flag is wrong.
-enum class BufferTimestamps { DriverFlag, StartOfExposure, EndOfFrame };
+// What a live camera's timestamps mean (source.timestamp_meaning): what the camera says
+// (DriverFlag, "auto": V4L2's TSTAMP_SRC flag; libcamera's SensorTimestamp as documented, the first
+// row's start of exposure), or a fixed meaning for drivers that say wrong: the first row's start or
+// end of exposure, or the last row's end of readout.
+enum class BufferTimestamps { DriverFlag, StartOfExposure, EndOfExposure, EndOfFrame };
 inline constexpr ChoiceName<BufferTimestamps> kBufferTimestampsNames[] = {
     {"auto", BufferTimestamps::DriverFlag},
     {"start-of-exposure", BufferTimestamps::StartOfExposure},
+    {"end-of-exposure", BufferTimestamps::EndOfExposure},
     {"end-of-frame", BufferTimestamps::EndOfFrame}};
 
 }  // namespace arpipe

@@ -40,6 +40,25 @@ TEST(LibcameraMetadata, EveryValuePresentMapsExactly) {
   EXPECT_EQ(m.colour_temperature_k, 5600);
 }
 
+// source.timestamp_meaning settles what a board's SensorTimestamp means without a rebuild
+// (docs/OPERATIONS.md, "What the timestamp means on this board"): the first row's end of exposure
+// is one exposure after its start; the last row's end of readout one exposure and one readout.
+TEST(LibcameraMetadata, TheConfiguredMeaningOfSensorTimestampGivesTheExposureStart) {
+  const int64_t raw = 5'000'123'456'789, exposure = 12'345'000, readout = 18'000'000, offset = -1'500'000;
+  const std::pair<BufferTimestamps, int64_t> cases[] = {
+      {BufferTimestamps::DriverFlag, raw + offset},
+      {BufferTimestamps::StartOfExposure, raw + offset},
+      {BufferTimestamps::EndOfExposure, raw - exposure + offset},
+      {BufferTimestamps::EndOfFrame, raw - exposure - readout + offset}};
+  for (const auto& [configured, start] : cases) {
+    auto timing = libcamera_timing(offset, readout, 0, 0, 30);
+    timing.sensor_timestamp = configured;
+    const auto r = map_libcamera_metadata(full_values(), 1, 999, timing);
+    EXPECT_EQ(r.meta.raw_timestamp_ns, raw);
+    EXPECT_EQ(r.meta.exposure_start_ns, start) << choice_name(kBufferTimestampsNames, configured);
+  }
+}
+
 TEST(LibcameraMetadata, MissingSensorTimestampFallsBackToTheBufferTimestampAsSensorTime) {
   auto v = full_values();
   v.sensor_timestamp_ns.reset();

@@ -21,7 +21,8 @@ SimCamera camera_at(double fps) {
 
 TEST(ExposureControl, MetadataRoundTripsThroughTheRawTimestamp) {
   for (const TimestampMeaning meaning :
-       {TimestampMeaning::StartOfExposure, TimestampMeaning::EndOfFrame, TimestampMeaning::Sensor}) {
+       {TimestampMeaning::StartOfExposure, TimestampMeaning::EndOfFrame, TimestampMeaning::EndOfExposure,
+        TimestampMeaning::Sensor}) {
     for (const int64_t offset : {int64_t(-7'654'321), int64_t(12'345'678)}) {
       SimCamera camera = camera_at(30);
       camera.timestamp_meaning = meaning;
@@ -40,10 +41,11 @@ TEST(ExposureControl, MetadataRoundTripsThroughTheRawTimestamp) {
         EXPECT_EQ(meta.digital_gain, 1.25);
         EXPECT_EQ(meta.raw_timestamp_meaning, meaning);
         EXPECT_EQ(meta.timestamp_offset_ns, offset);
-        // What the driver stamps: the last row's end for end-of-frame, else the first row's start,
-        // on a clock `offset` behind ours.
-        const int64_t raw = meaning == TimestampMeaning::EndOfFrame ? start - offset + 8'000'000 + 15'000'000
-                                                                   : start - offset;
+        // What the driver stamps: the last row's end for end-of-frame, the first row's end for
+        // end-of-exposure, else the first row's start, on a clock `offset` behind ours.
+        const int64_t raw = meaning == TimestampMeaning::EndOfFrame      ? start - offset + 8'000'000 + 15'000'000
+                            : meaning == TimestampMeaning::EndOfExposure ? start - offset + 8'000'000
+                                                                         : start - offset;
         EXPECT_EQ(meta.raw_timestamp_ns, raw);
         EXPECT_EQ(exposure_start_from_raw(meta.raw_timestamp_ns, meta.raw_timestamp_meaning, meta.exposure_ns,
                                           meta.readout_ns, meta.timestamp_offset_ns),

@@ -318,7 +318,7 @@ TEST(Config, OutOfRangeValuesSayWhatWasExpected) {
   expect_error("[source]\nbuffers = 2\n", {"test.toml:2:11:", "source.buffers: expected an integer in [4, 32], found 2"});
   expect_error("[source]\npixel_format = \"H264\"\n", {"source.pixel_format: expected one of \"auto\"", "found \"H264\""});
   expect_error("[source]\ntimestamp_meaning = \"middle\"\n",
-               {"source.timestamp_meaning: expected one of \"auto\", \"start-of-exposure\", \"end-of-frame\""});
+               {"source.timestamp_meaning: expected one of \"auto\", \"start-of-exposure\", \"end-of-exposure\", \"end-of-frame\""});
   expect_error("[source]\nreconnect_min_ms = 500\nreconnect_max_ms = 100\n",
                {"test.toml:3:", "source.reconnect_max_ms: expected at least reconnect_min_ms (500), found 100"});
   expect_error("[source]\npacing = \"slow\"\n", {"source.pacing: expected one of \"timestamps\", \"fast\""});
