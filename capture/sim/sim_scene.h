@@ -154,6 +154,9 @@ struct SimSensor {
   double read_noise_electrons = 3.0;
   bool noise = true;                    // false: a noise-free sensor (exact tests)
   CameraResponse response;              // "srgb" (default), "linear" or "gamma:<g>" (value^(1/g))
+  // Raw (Bayer) formats only: the code of zero light at the format's bit depth (e.g. 64 at 10
+  // bits); full scale is the top code, 2^bits - 1. Raw values are linear: no response curve.
+  int black_level = 0;
 };
 
 // Auto-exposure: after each frame, scale the next exposure so the mean linear value of the frame

@@ -186,7 +186,8 @@ SimCamera read_camera(const TomlSection& s) {
     camera.model = read_camera_model(s);
 
   camera.pixel_format = s.parsed<PixelFormat>("pixel_format", camera.pixel_format, pixel_format_from_name,
-                                              "one of \"GREY\", \"RGB24\", \"YUYV\", \"NV12\"");
+                                              "one of \"GREY\", \"RGB24\", \"YUYV\", \"NV12\" or a Bayer format "
+                                              "(SRGGB, SBGGR, SGRBG or SGBRG with 8, 10, 12, 16, 10P or 12P: \"SRGGB10P\")");
   if (const auto stereo = s.section("stereo")) {
     SimStereo& out = camera.stereo;
     out.enabled = true;
@@ -287,6 +288,14 @@ SimCamera read_camera(const TomlSection& s) {
     out.noise = sensor->boolean("noise", out.noise);
     out.response = sensor->parsed<CameraResponse>("response", out.response, response_curve,
                                                "\"srgb\", \"linear\" or \"gamma:<g>\" with g > 0");
+    // The black level is a raw sensor's: in codes of the Bayer format's depth, below full scale.
+    if (sensor->has("black_level")) {
+      const int bits = bayer_bit_depth(camera.pixel_format);
+      if (bits == 0)
+        sensor->fail_with("black_level", fmt::format("applies to raw Bayer pixel formats only, and camera.pixel_format is {}",
+                                                     pixel_format_name(camera.pixel_format)));
+      out.black_level = sensor->integer_as<int>("black_level", out.black_level, IntRange{0, (1 << bits) - 2});
+    }
   }
   return camera;
 }

@@ -17,6 +17,7 @@
 #include "capture/sim/exposure_control.h"
 #include "capture/sim/frame_renderer.h"
 #include "capture/sim/ground_truth_coverage.h"
+#include "capture/sim/raw_exposure.h"
 #include "capture/sim/scene_shader.h"
 #include "capture/sim/sensor_model.h"
 #include "capture/sim/shutter_pose_table.h"
@@ -239,8 +240,12 @@ SimulateSummary simulate(const SimScene& scene, const SimulateOptions& options) 
       truth.linear_image = fmt::format("linear_{:06d}.pfm", k);
       write_linear_image(options.out_dir / truth.linear_image, radiance, sensor, exposure);
     }
-    writer.append(to_frame(expose(radiance, sensor, exposure, seed, index), width, height, camera.pixel_format, meta),
-                  truth);
+    // A raw camera's frame is the mosaic (raw_exposure.h); every other format encodes the RGB.
+    Frame frame = is_bayer(camera.pixel_format)
+                      ? expose_bayer(radiance, sensor, exposure, seed, index, camera.pixel_format, camera.sensor.black_level)
+                      : to_frame(expose(radiance, sensor, exposure, seed, index), width, height, camera.pixel_format, meta);
+    frame.meta = meta;
+    writer.append(frame, truth);
     if (composite_world) {
       render_frame(renderer, camera, *composite_world, poses, meta, start_s, index, composite_radiance, &coverage);
       composite_writer->append(
