@@ -32,6 +32,7 @@
 #include "core/frame_memory.h"
 #include "core/log.h"
 #include "core/pipeline/bounded_queue.h"
+#include "core/pipeline/frame_pool.h"
 #include "core/pipeline/monotonic_clock.h"
 #include "tests/v4l2_standin/v4l2_standin.h"
 
@@ -92,6 +93,7 @@ struct Row {
   size_t camera_bytes = 0, frame_bytes = 0;
   double dequeue_us = 0, convert_us = 0, handoff_us = 0, memcpy_us = 0;
   double page_faults = 0;  // minor page faults per frame, the whole process (stand-in included)
+  double copies = 0, allocations = 0;  // per frame, as the source counts them
 };
 
 long minor_faults() {
@@ -116,8 +118,10 @@ Row measure(const fs::path& dir, const fs::path& recording, CaptureFormat camera
   const StreamCounters before = source->counters().stream;
   const long faults_before = minor_faults();
   int64_t handoff = 0;
+  FramePool pool;  // as the pipeline does: the memory of a frame the sinks are done with comes back
   for (int i = 0; i < frames; ++i) {
     Frame frame;
+    frame.data = pool.take();
     while (source->next(frame) != SourceStatus::Frame) {
     }
     row.frame_bytes = frame.data.size();
@@ -125,13 +129,15 @@ Row measure(const fs::path& dir, const fs::path& recording, CaptureFormat camera
     queue.push(std::move(frame));  // what the capture thread does with it; the pop is the next thread's
     const int64_t t1 = monotonic_now_ns();
     handoff += t1 - t0;
-    queue.pop();
+    if (auto done = queue.pop()) pool.give(std::move(done->data));
   }
   const StreamCounters after = source->counters().stream;
   row.page_faults = double(minor_faults() - faults_before) / frames;
   row.dequeue_us = double(after.dequeue_ns - before.dequeue_ns) / frames * 1e-3;
   row.convert_us = double(after.convert_ns - before.convert_ns) / frames * 1e-3;
   row.handoff_us = double(handoff) / frames * 1e-3;
+  row.copies = double(after.copies - before.copies) / frames;
+  row.allocations = double(after.frame_allocations - before.frame_allocations) / frames;
   row.memcpy_us = memcpy_ns(row.frame_bytes, frames) * 1e-3;
   g_standin.unload();
   return row;
@@ -199,13 +205,14 @@ int run_capture_path_benchmark(const CapturePathOptions& options) {
     fmt::print("capture path through the V4L2 stand-in: {} ({}x{} {}), {} frames per format\n\n", recording.string(),
                reader.info().width, reader.info().height, pixel_format_name(reader.info().pixel_format), frames);
     fmt::print("| camera sends | frame bytes | DQBUF+QBUF µs | copy/decode µs | hand-off µs | memcpy µs | "
-               "(copy/decode + hand-off) / memcpy | page faults/frame |\n|---|---:|---:|---:|---:|---:|---:|---:|\n");
+               "(copy/decode + hand-off) / memcpy | page faults/frame | copies/frame | allocations/frame |\n"
+               "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     for (const CaptureFormat format : {CaptureFormat::YUYV, CaptureFormat::GREY, CaptureFormat::RGB24,
                                        CaptureFormat::NV12, CaptureFormat::MJPG}) {
       const Row r = measure(dir, recording, format, frames);
-      fmt::print("| {} | {} | {:.1f} | {:.1f} | {:.2f} | {:.1f} | {:.2f} | {:.0f} |\n", r.format, r.frame_bytes,
-                 r.dequeue_us, r.convert_us, r.handoff_us, r.memcpy_us, (r.convert_us + r.handoff_us) / r.memcpy_us,
-                 r.page_faults);
+      fmt::print("| {} | {} | {:.1f} | {:.1f} | {:.2f} | {:.1f} | {:.2f} | {:.0f} | {:.2f} | {:.2f} |\n", r.format,
+                 r.frame_bytes, r.dequeue_us, r.convert_us, r.handoff_us, r.memcpy_us,
+                 (r.convert_us + r.handoff_us) / r.memcpy_us, r.page_faults, r.copies, r.allocations);
     }
     const auto ms = latencies_ms(dir, recording, std::min(frames, 90));
     const auto at = [&](double q) { return ms[std::min(ms.size() - 1, size_t(q * double(ms.size())))]; };

@@ -28,6 +28,8 @@ void add(StreamCounters& sum, const StreamCounters& c) {
   sum.control_events += c.control_events;
   sum.dequeue_ns += c.dequeue_ns;
   sum.convert_ns += c.convert_ns;
+  sum.copies += c.copies;
+  sum.frame_allocations += c.frame_allocations;
 }
 
 }  // namespace
@@ -177,6 +179,11 @@ std::string LiveSource::describe(const LiveCounters& c) {
                      c.stream.frames, c.stream.sequence_gaps, c.stream.timeouts, c.stream.again,
                      c.stream.error_buffers, c.stream.control_events, c.disconnects, c.reconnects, c.failed_opens,
                      c.frames_missed_while_away);
+}
+
+std::optional<CaptureCounts> LiveSource::capture_counts() const {
+  const StreamCounters s = counters().stream;
+  return CaptureCounts{s.frames, s.copies, s.frame_allocations};
 }
 
 bool LiveSource::connected() const {

@@ -48,6 +48,7 @@ class LiveSource : public FrameSource {
   void interrupt() override;
   std::string health() const override;
   bool connected() const override;
+  std::optional<CaptureCounts> capture_counts() const override;
 
   const StreamFormat& format() const;  // as first negotiated
   LiveCounters counters() const;

@@ -12,6 +12,12 @@ namespace arpipe {
 
 enum class SourceStatus { Frame, EndOfStream, Retry };
 
+struct CaptureCounts {
+  uint64_t frames = 0;
+  uint64_t copies = 0;             // full passes over a frame's bytes out of the driver's buffer
+  uint64_t frame_allocations = 0;  // frames whose memory was allocated rather than reused
+};
+
 class FrameSource {
  public:
   virtual ~FrameSource() = default;
@@ -33,6 +39,9 @@ class FrameSource {
   virtual std::string health() const { return {}; }
   // False while a live camera is away (unplugged, being reopened). Thread-safe.
   virtual bool connected() const { return true; }
+  // What a camera's capture path did with its frames' bytes, when it counts (the V4L2 source):
+  // copies from the driver's buffers and frames whose memory had to be allocated. Thread-safe.
+  virtual std::optional<CaptureCounts> capture_counts() const { return std::nullopt; }
 };
 
 }  // namespace arpipe

@@ -115,6 +115,7 @@ void PipelineRunner::capture_loop() {
     const int64_t max_frames = max_frames_.load();
     if (max_frames > 0 && int64_t(index) >= max_frames) break;
     FrameContext ctx;
+    ctx.camera.data = frame_pool_->take();  // a source that copies into it allocates nothing
     SourceStatus status = SourceStatus::EndOfStream;
     try {
       status = source_->next(ctx.camera);
@@ -273,7 +274,12 @@ void PipelineRunner::sink_loop() {
       item->frame = std::move(*pair);
     }
     const int64_t origin_ns = item->frame.latency_origin_ns();
-    auto frame = std::make_shared<const FrameContext>(std::move(item->frame));
+    // When the last sink lets go of the frame, its camera image's memory goes back to the source.
+    auto frame = std::shared_ptr<const FrameContext>(
+        new FrameContext(std::move(item->frame)), [pool = frame_pool_](FrameContext* done) {
+          pool->give(std::move(done->camera.data));
+          delete done;
+        });
     for (auto& worker : sinks_) worker->push(frame);
     const int64_t now = monotonic_now_ns();
     sink_busy_since_ns_ = 0;
@@ -378,6 +384,7 @@ PipelineStatus PipelineRunner::status() const {
   }
   status.source = source_->describe();
   status.source_health = source_->health();
+  status.capture = source_->capture_counts();
   status.live = source_->is_live();
   status.source_connected = source_->connected();
   status.uptime_seconds = start_ns_ ? double(monotonic_now_ns() - start_ns_) * 1e-9 : 0;

@@ -13,6 +13,7 @@
 
 #include "core/config/config.h"
 #include "core/pipeline/bounded_queue.h"
+#include "core/pipeline/frame_pool.h"
 #include "core/pipeline/frame_sink.h"
 #include "core/pipeline/frame_source.h"
 #include "core/pipeline/pipeline_metrics.h"
@@ -95,6 +96,8 @@ class PipelineRunner {
   };
 
   std::unique_ptr<FrameSource> source_;
+  // The camera images' memory, back from the sinks for the source to fill again.
+  std::shared_ptr<FramePool> frame_pool_ = std::make_shared<FramePool>();
   StageFactory stage_factory_;
   SinkFactory sink_factory_;
   std::vector<SinkSlot> sink_slots_;

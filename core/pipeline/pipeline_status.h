@@ -4,9 +4,11 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "core/pipeline/frame_source.h"
 #include "core/pipeline/pipeline_metrics.h"
 
 namespace arpipe {
@@ -25,6 +27,7 @@ struct PipelineStatus {
   std::string source_health;     // its counters, in words
   bool live = false;             // a camera (drops when behind) rather than a replay (blocks)
   bool source_connected = true;  // false while a live camera is away
+  std::optional<CaptureCounts> capture;  // a camera's copies and allocations, when it counts them
   double uptime_seconds = 0;
 };
 

@@ -11,6 +11,10 @@ nlohmann::json pipeline_status_json(const PipelineStatus& status) {
                  {"live", status.live},
                  {"connected", status.source_connected},
                  {"health", status.source_health}};
+  if (status.capture)
+    j["camera"]["capture"] = {{"frames", status.capture->frames},
+                              {"copies", status.capture->copies},
+                              {"frame_allocations", status.capture->frame_allocations}};
   const PipelineMetrics& m = status.metrics;
   json stages = json::object();
   for (const auto& [name, stats] : m.stages) {

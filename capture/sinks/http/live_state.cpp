@@ -64,6 +64,14 @@ std::string live_metrics_text(const PipelineStatus& status, bool camera_away, co
   for (const SinkStats& s : status.sinks) w.sample("arpipe_sink_queued_frames", {{"sink", s.key}}, double(s.queued));
   w.family("arpipe_camera_connected", "gauge", "1 while the source delivers (a live camera is present), else 0.");
   w.sample("arpipe_camera_connected", status.source_connected && !camera_away ? 1 : 0);
+  if (status.capture) {
+    w.family("arpipe_capture_copies_total", "counter",
+             "Full copies of a frame out of the camera driver's buffers (one a frame when the driver's memory cannot be imported).");
+    w.sample("arpipe_capture_copies_total", double(status.capture->copies));
+    w.family("arpipe_capture_frame_allocations_total", "counter",
+             "Camera frames whose memory was allocated rather than reused from a frame the sinks were done with.");
+    w.sample("arpipe_capture_frame_allocations_total", double(status.capture->frame_allocations));
+  }
   w.family("arpipe_source_live", "gauge", "1 for a live camera, 0 for a replay.");
   w.sample("arpipe_source_live", status.live ? 1 : 0);
   w.family("arpipe_uptime_seconds", "gauge", "Seconds since the pipeline started.");

@@ -1,0 +1,44 @@
+// Pixel memory that the pipeline hands back to the source: when the last sink is done with a
+// frame, its camera image's bytes (capacity kept) wait here for the capture thread, which gives
+// them to the source to fill again. A source that copies into the Frame it is given (the V4L2
+// source) then allocates nothing per frame in steady state. Thread-safe; keeps at most `keep`.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <mutex>
+#include <vector>
+
+namespace arpipe {
+
+class FramePool {
+ public:
+  explicit FramePool(size_t keep = 8) : keep_(keep) {}
+
+  // Bytes to fill (their old contents, or empty when none wait).
+  std::vector<uint8_t> take() {
+    std::lock_guard lock(mutex_);
+    if (kept_.empty()) return {};
+    std::vector<uint8_t> bytes = std::move(kept_.back());
+    kept_.pop_back();
+    ++reused_;
+    return bytes;
+  }
+  void give(std::vector<uint8_t>&& bytes) {
+    if (bytes.capacity() == 0) return;
+    std::lock_guard lock(mutex_);
+    if (kept_.size() < keep_) kept_.push_back(std::move(bytes));
+  }
+  uint64_t reused() const {
+    std::lock_guard lock(mutex_);
+    return reused_;
+  }
+
+ private:
+  const size_t keep_;
+  mutable std::mutex mutex_;
+  std::vector<std::vector<uint8_t>> kept_;
+  uint64_t reused_ = 0;
+};
+
+}  // namespace arpipe
