@@ -211,6 +211,7 @@ void LibcameraStream::configure(const SourceConfig& config) {
   std::optional<PixelFormat> wanted_format;
   if (config.pixel_format != CaptureFormat::Auto) {
     wanted_format = frame_format(config.pixel_format);
+    if (wanted_format && !libcamera_pixel_format(*wanted_format).isValid()) wanted_format.reset();  // raw Bayer
     if (!wanted_format)
       throw CameraError(Kind::Refused, fmt::format("libcamera camera '{}': pixel format {} is not one arpipe takes "
                                                    "from libcamera (RGB24, YUYV, NV12, GREY); the camera offers {}",

@@ -32,25 +32,31 @@ inline constexpr ChoiceName<StreamRole> kStreamRoleNames[] = {{"video", StreamRo
 // The pixel format asked of a live camera (source.pixel_format): a frame format, MJPG (decoded to
 // RGB24 by the V4L2 source), a V4L2 format the V4L2 source reorders into a frame format as it copies
 // (UYVY, YVYU, NV16 -> YUYV; NV21, YUV420 -> NV12; the "M" ones are their split-plane twins, named
-// as V4L2_PIX_FMT_*), or Auto (what the camera offers first, formats taken as they are first).
-enum class CaptureFormat { Auto, YUYV, NV12, RGB24, GREY, MJPG, UYVY, YVYU, NV21, YUV420, NV16, NV12M, NV21M, YUV420M, NV16M };
+// as V4L2_PIX_FMT_*), a raw Bayer format (passed on raw: core/image/bayer.h develops it), or Auto
+// (what the camera offers first, formats taken as they are first).
+enum class CaptureFormat {
+  Auto, YUYV, NV12, RGB24, GREY, MJPG, UYVY, YVYU, NV21, YUV420, NV16, NV12M, NV21M, YUV420M, NV16M,
+  SRGGB8, SBGGR8, SGRBG8, SGBRG8, SRGGB10, SBGGR10, SGRBG10, SGBRG10, SRGGB12, SBGGR12, SGRBG12, SGBRG12, SRGGB16, SBGGR16, SGRBG16, SGBRG16, SRGGB10P, SBGGR10P, SGRBG10P, SGBRG10P, SRGGB12P, SBGGR12P, SGRBG12P, SGBRG12P
+};
 inline constexpr ChoiceName<CaptureFormat> kCaptureFormatNames[] = {
     {"auto", CaptureFormat::Auto},     {"YUYV", CaptureFormat::YUYV},   {"NV12", CaptureFormat::NV12},
     {"RGB24", CaptureFormat::RGB24},   {"GREY", CaptureFormat::GREY},   {"MJPG", CaptureFormat::MJPG},
     {"UYVY", CaptureFormat::UYVY},     {"YVYU", CaptureFormat::YVYU},   {"NV21", CaptureFormat::NV21},
     {"YUV420", CaptureFormat::YUV420}, {"NV16", CaptureFormat::NV16},   {"NV12M", CaptureFormat::NV12M},
-    {"NV21M", CaptureFormat::NV21M},   {"YUV420M", CaptureFormat::YUV420M}, {"NV16M", CaptureFormat::NV16M}};
+    {"NV21M", CaptureFormat::NV21M},   {"YUV420M", CaptureFormat::YUV420M}, {"NV16M", CaptureFormat::NV16M},
+    {"SRGGB8", CaptureFormat::SRGGB8}, {"SBGGR8", CaptureFormat::SBGGR8}, {"SGRBG8", CaptureFormat::SGRBG8}, {"SGBRG8", CaptureFormat::SGBRG8},
+    {"SRGGB10", CaptureFormat::SRGGB10}, {"SBGGR10", CaptureFormat::SBGGR10}, {"SGRBG10", CaptureFormat::SGRBG10}, {"SGBRG10", CaptureFormat::SGBRG10},
+    {"SRGGB12", CaptureFormat::SRGGB12}, {"SBGGR12", CaptureFormat::SBGGR12}, {"SGRBG12", CaptureFormat::SGRBG12}, {"SGBRG12", CaptureFormat::SGBRG12},
+    {"SRGGB16", CaptureFormat::SRGGB16}, {"SBGGR16", CaptureFormat::SBGGR16}, {"SGRBG16", CaptureFormat::SGRBG16}, {"SGBRG16", CaptureFormat::SGBRG16},
+    {"SRGGB10P", CaptureFormat::SRGGB10P}, {"SBGGR10P", CaptureFormat::SBGGR10P}, {"SGRBG10P", CaptureFormat::SGRBG10P}, {"SGBRG10P", CaptureFormat::SGBRG10P},
+    {"SRGGB12P", CaptureFormat::SRGGB12P}, {"SBGGR12P", CaptureFormat::SBGGR12P}, {"SGRBG12P", CaptureFormat::SGRBG12P}, {"SGBRG12P", CaptureFormat::SGBRG12P},
+};
 
-// The frame format a CaptureFormat names; nullopt for Auto, MJPG and the V4L2-only formats.
+// The frame format a CaptureFormat names (the four frame formats and the Bayer ones, by name);
+// nullopt for Auto, MJPG and the formats only the V4L2 source reorders.
 inline std::optional<PixelFormat> frame_format(CaptureFormat format) {
-  switch (format) {
-    case CaptureFormat::YUYV: return PixelFormat::YUYV;
-    case CaptureFormat::NV12: return PixelFormat::NV12;
-    case CaptureFormat::RGB24: return PixelFormat::RGB24;
-    case CaptureFormat::GREY: return PixelFormat::GREY;
-    default: return std::nullopt;  // Auto, MJPG and the formats only the V4L2 source reorders
-  }
-  return std::nullopt;
+  if (format == CaptureFormat::Auto || format == CaptureFormat::MJPG) return std::nullopt;
+  return pixel_format_from_name(choice_name(kCaptureFormatNames, format));
 }
 
 // What a live camera's timestamps mean (source.timestamp_meaning): what the camera says
