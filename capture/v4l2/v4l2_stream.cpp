@@ -234,8 +234,10 @@ class V4L2Stream final : public CameraStream {
                : layout_.kind != V4L2FrameLayout::Kind::AsIs
                      ? fmt::format(" (reordered to {} as it is copied)", pixel_format_name(layout_.frame_format))
                      : "";
-    return fmt::format("{} {}x{}{}{}, {} buffers", format_.camera_format, format_.width, format_.height, rate, decoded,
-                       buffers_->count());
+    const std::string planes =
+        device_.multi_planar() ? fmt::format(" of {} plane{}", memory_planes_, memory_planes_ > 1 ? "s" : "") : "";
+    return fmt::format("{} {}x{}{}{}, {} {}buffers{}", format_.camera_format, format_.width, format_.height, rate,
+                       decoded, buffers_->count(), device_.multi_planar() ? "multi-planar " : "", planes);
   }
 
   template <typename F> void count(F&& update) {

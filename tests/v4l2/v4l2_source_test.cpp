@@ -366,3 +366,56 @@ TEST(V4L2Source, ThePipelineRecyclesFrameMemoryAndCopiesEachFrameOnce) {
 
 }  // namespace
 }  // namespace arpipe
+
+namespace arpipe {
+namespace {
+
+// Three frames of the default capture as the source gets them from a stand-in serving `format`.
+std::vector<Frame> frames_served_as(const std::string& name, const std::string& format, const std::string& buffer_type,
+                                    CaptureFormat asked) {
+  const auto dir = test::v4l2_scratch("layout-" + name);
+  test::StandinDevice device(dir, default_capture(),
+                             fmt::format("formats = [\"{}\"]\nbuffer_type = \"{}\"\npacing = \"fast\"", format, buffer_type));
+  auto config = v4l2_config();
+  config.pixel_format = asked;
+  auto source = make_live_source(config);
+  return take_frames(*source, 3);
+}
+
+// Issue 24's multi-planar capture and new formats, end to end through the stand-in (which makes
+// each by reordering the YUYV or NV12 bytes of the recording's frame, tests/v4l2_standin/
+// yuv_layouts.h): the source must give exactly the frame a camera sending YUYV or NV12 gives, with
+// the same sequence and exposure times.
+TEST(V4L2Source, MultiPlanarAndReorderedFormatsGiveTheFramesOfTheFormatTheyCarry) {
+  const std::vector<Frame> yuyv = frames_served_as("yuyv", "YUYV", "single", CaptureFormat::YUYV);
+  const std::vector<Frame> nv12 = frames_served_as("nv12", "NV12", "single", CaptureFormat::NV12);
+  ASSERT_EQ(yuyv.size(), 3u);
+  ASSERT_EQ(nv12.size(), 3u);
+  struct Case {
+    const char* served;
+    const char* buffer_type;
+    CaptureFormat asked;
+    const std::vector<Frame>& expected;
+  };
+  const Case cases[] = {{"YUYV", "mplane", CaptureFormat::YUYV, yuyv},     {"UYVY", "single", CaptureFormat::UYVY, yuyv},
+                        {"YVYU", "mplane", CaptureFormat::YVYU, yuyv},     {"NV16", "single", CaptureFormat::NV16, yuyv},
+                        {"NV16M", "mplane", CaptureFormat::NV16M, yuyv},   {"NV12", "mplane", CaptureFormat::NV12, nv12},
+                        {"NV21", "single", CaptureFormat::NV21, nv12},     {"YU12", "mplane", CaptureFormat::YUV420, nv12},
+                        {"NV12M", "mplane", CaptureFormat::NV12M, nv12},   {"NV21M", "mplane", CaptureFormat::NV21M, nv12},
+                        {"YUV420M", "mplane", CaptureFormat::YUV420M, nv12}};
+  for (const Case& c : cases) {
+    SCOPED_TRACE(fmt::format("{} ({})", c.served, c.buffer_type));
+    const std::vector<Frame> got = frames_served_as(c.served, c.served, c.buffer_type, c.asked);
+    ASSERT_EQ(got.size(), 3u);
+    for (size_t i = 0; i < 3; ++i) {
+      EXPECT_EQ(got[i].format, c.expected[i].format);
+      EXPECT_EQ(got[i].bytes_per_line, c.expected[i].bytes_per_line);
+      EXPECT_TRUE(got[i].data == c.expected[i].data) << "frame " << i;
+      EXPECT_EQ(got[i].meta.sequence, c.expected[i].meta.sequence);
+      EXPECT_EQ(got[i].meta.exposure_start_ns, c.expected[i].meta.exposure_start_ns);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace arpipe
