@@ -12,48 +12,22 @@
 #include "capture/sinks/png_sink.h"
 #include "core/image/pixel_convert.h"
 #include "tests/e2e/child_process.h"
+#include "tests/e2e/default_capture_truth.h"
 
 namespace fs = std::filesystem;
 using namespace arpipe;
+using test::tag_fully_visible;
+using test::tag_out_of_view;
 
 namespace {
 
 const fs::path kCapture = fs::path(ARPIPE_BINARY_DIR) / "default-capture";
 const fs::path kConfig = fs::path(ARPIPE_SOURCE_DIR) / "configs" / "arpipe.toml";
-constexpr double kTagSize = 0.1;  // configs/arpipe.toml: tag 0, 10 cm
-
 std::vector<nlohmann::json> read_jsonl(const fs::path& path) {
   std::vector<nlohmann::json> lines;
   std::ifstream in(path);
   for (std::string line; std::getline(in, line);) lines.push_back(nlohmann::json::parse(line));
   return lines;
-}
-
-// Ground-truth visibility: every tag corner (with its white border) projects inside the image with a margin.
-bool tag_fully_visible(const CameraModel& model, const SE3& T_cam_world, double margin_px) {
-  const double h = kTagSize / 2 * 10.0 / 8.0;  // white border included
-  for (double sx : {-1.0, 1.0})
-    for (double sy : {-1.0, 1.0}) {
-      const Vec3 p = T_cam_world * Vec3{sx * h, sy * h, 0};
-      if (p[2] <= 0) return false;
-      const auto px = model.project(p);
-      if (!px || (*px)[0] < margin_px || (*px)[1] < margin_px || (*px)[0] > model.width() - 1 - margin_px ||
-          (*px)[1] > model.height() - 1 - margin_px)
-        return false;
-    }
-  return true;
-}
-bool tag_out_of_view(const CameraModel& model, const SE3& T_cam_world) {
-  const Vec3 c = T_cam_world * Vec3{0, 0, 0};
-  if (c[2] <= 0) return true;
-  const double h = kTagSize / 2 * 10.0 / 8.0;
-  for (double sx : {-1.0, 1.0})
-    for (double sy : {-1.0, 1.0}) {
-      const auto px = model.project(T_cam_world * Vec3{sx * h, sy * h, 0});
-      if (px && (*px)[0] >= 0 && (*px)[1] >= 0 && (*px)[0] <= model.width() - 1 && (*px)[1] <= model.height() - 1)
-        return false;
-    }
-  return true;
 }
 
 // ctest runs each test in its own process, in parallel, so each run gets its own output folder.
