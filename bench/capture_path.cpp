@@ -29,6 +29,8 @@
 #include "bench/benchmarks.h"
 #include "capture/live/live_source.h"
 #include "capture/recording/recording_reader.h"
+#include "capture/recording/recording_writer.h"
+#include "core/image/pixel_convert.h"
 #include "core/frame_memory.h"
 #include "core/log.h"
 #include "core/pipeline/bounded_queue.h"
@@ -102,14 +104,21 @@ long minor_faults() {
   return usage.ru_minflt;
 }
 
-// The stand-in sends `camera_format` and the source asks for it by the same name.
-Row measure(const fs::path& dir, const fs::path& recording, CaptureFormat camera_format, int frames) {
-  load_standin(dir, recording, fmt::format("pacing = \"fast\"\nformats = [\"{}\"]\nloop = true",
-                                           choice_name(kCaptureFormatNames, camera_format)));
-  auto source = make_live_source(source_config(camera_format));
+// What the stand-in sends (its name for it, and its buffer type) and what the source asks for.
+struct Served {
+  std::string standin_format;
+  std::string buffer_type;
+  CaptureFormat asked;
+};
+
+Row measure(const fs::path& dir, const fs::path& recording, const Served& served, int frames) {
+  load_standin(dir, recording,
+               fmt::format("pacing = \"fast\"\nformats = [\"{}\"]\nbuffer_type = \"{}\"\nloop = true",
+                           served.standin_format, served.buffer_type));
+  auto source = make_live_source(source_config(served.asked));
   BoundedQueue<Frame> queue(4, OverflowPolicy::DropOldest);
   Row row;
-  row.format = source->format().camera_format;
+  row.format = source->format().camera_format + (served.buffer_type == "mplane" ? " (multi-planar)" : "");
   for (int i = 0; i < 10; ++i) {  // warm-up: first buffers, allocator, decoder
     Frame frame;
     while (source->next(frame) != SourceStatus::Frame) {
@@ -160,6 +169,44 @@ std::vector<double> latencies_ms(const fs::path& dir, const fs::path& recording,
   return ms;
 }
 
+// The recording's first frames in another format (a raw sensor's Bayer: each pixel's filter
+// channel of its linear value), so that the stand-in serves them as they are: converting them as
+// it serves would run beside the copy being measured and share the caches with it.
+fs::path format_copy(const fs::path& recording, const fs::path& dir, PixelFormat format, size_t frames) {
+  const RecordingReader reader(recording);
+  RecordingInfo info;
+  info.pixel_format = format;
+  info.width = reader.info().width;
+  info.height = reader.info().height;
+  info.source = "bench capture-path: a copy in another format";
+  const fs::path out = dir / std::string(pixel_format_name(format));
+  fs::remove_all(out);
+  RecordingWriter writer(out, info, reader.camera_model());
+  std::vector<uint8_t> rgb;
+  for (size_t i = 0; i < std::min(frames, reader.frame_count()); ++i) {
+    Frame frame;
+    reader.read(i, frame);
+    to_rgb24(frame, rgb);
+    Frame raw = from_rgb24(rgb.data(), frame.width, frame.height, info.pixel_format);
+    raw.meta = frame.meta;
+    writer.append(raw);
+  }
+  writer.flush();
+  return out;
+}
+
+// ms to develop one raw frame into RGB24 (black level, white balance, demosaic, sRGB), the mean of `repeats`.
+double develop_ms(const fs::path& bayer, int repeats) {
+  const RecordingReader reader(bayer);
+  Frame raw;
+  reader.read(0, raw);
+  std::vector<uint8_t> rgb;
+  to_rgb24(raw, rgb);  // warm-up
+  const int64_t start = monotonic_now_ns();
+  for (int i = 0; i < repeats; ++i) to_rgb24(raw, rgb);
+  return double(monotonic_now_ns() - start) * 1e-6 / repeats;
+}
+
 struct CapturePathOptions {
   fs::path recording = fs::path(ARPIPE_BINARY_DIR) / "default-capture";
   int frames = 300;
@@ -207,13 +254,31 @@ int run_capture_path_benchmark(const CapturePathOptions& options) {
     fmt::print("| camera sends | frame bytes | DQBUF+QBUF µs | copy/decode µs | hand-off µs | memcpy µs | "
                "(copy/decode + hand-off) / memcpy | page faults/frame | copies/frame | allocations/frame |\n"
                "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
-    for (const CaptureFormat format : {CaptureFormat::YUYV, CaptureFormat::GREY, CaptureFormat::RGB24,
-                                       CaptureFormat::NV12, CaptureFormat::MJPG}) {
-      const Row r = measure(dir, recording, format, frames);
+    const Served served[] = {{"YUYV", "single", CaptureFormat::YUYV},    {"GREY", "single", CaptureFormat::GREY},
+                             {"RGB24", "single", CaptureFormat::RGB24},  {"NV12", "single", CaptureFormat::NV12},
+                             {"NV12M", "mplane", CaptureFormat::NV12M},  {"UYVY", "single", CaptureFormat::UYVY},
+                             {"NV21", "single", CaptureFormat::NV21},    {"YU12", "single", CaptureFormat::YUV420},
+                             {"YUV420M", "mplane", CaptureFormat::YUV420M}, {"NV16", "single", CaptureFormat::NV16},
+                             {"MJPG", "single", CaptureFormat::MJPG}};
+    // The pipeline's own formats and Bayer served as recorded; the others reordered by the stand-in.
+    std::vector<std::pair<Served, fs::path>> rows;
+    for (const Served& format : served) {
+      const auto own = frame_format(format.asked);
+      if (own && format.buffer_type == "single" && *own != reader.info().pixel_format)
+        rows.push_back({Served{"native", "single", format.asked}, format_copy(recording, dir, *own, 30)});
+      else
+        rows.push_back({format, recording});
+    }
+    const fs::path bayer = format_copy(recording, dir, PixelFormat::SGRBG10P, 30);
+    rows.insert(rows.end() - 1, {Served{"native", "single", CaptureFormat::SGRBG10P}, bayer});
+    for (const auto& [format, from] : rows) {
+      const Row r = measure(dir, from, format, frames);
       fmt::print("| {} | {} | {:.1f} | {:.1f} | {:.2f} | {:.1f} | {:.2f} | {:.0f} | {:.2f} | {:.2f} |\n", r.format,
                  r.frame_bytes, r.dequeue_us, r.convert_us, r.handoff_us, r.memcpy_us,
                  (r.convert_us + r.handoff_us) / r.memcpy_us, r.page_faults, r.copies, r.allocations);
     }
+    fmt::print("\nSGRBG10P developed to RGB24 where the pixels are read (black level, white balance, OpenCV's "
+               "edge-aware demosaic, sRGB; core/image/bayer.h): {:.2f} ms a frame\n", develop_ms(bayer, 20));
     const auto ms = latencies_ms(dir, recording, std::min(frames, 90));
     const auto at = [&](double q) { return ms[std::min(ms.size() - 1, size_t(q * double(ms.size())))]; };
     fmt::print("\nexposure end to hand-off (real-time pacing, {} frames): median {:.3f} ms, p90 {:.3f} ms, max {:.3f} ms\n",

@@ -81,21 +81,33 @@ uint32_t load32(const uint8_t* p) {
   return x;
 }
 
-// Y0 U Y1 V from any order of the four bytes (the shifts are the same for every pair: vectorised).
-void packed_to_yuyv(const uint8_t* in, uint8_t* out, int pairs, const V4L2FrameLayout& l) {
-  const unsigned sy0 = 8u * l.y0, su = 8u * l.u, sy1 = 8u * l.y1, sv = 8u * l.v;
+// Y0 U Y1 V from another order of the four bytes of each pixel pair, with the byte positions fixed
+// at compile time so that the loop is a few vector shifts and masks.
+template <unsigned Y0, unsigned U, unsigned Y1, unsigned V>
+void reorder_pairs(const uint8_t* in, uint8_t* out, int pairs) {
   for (int i = 0; i < pairs; ++i) {
     const uint32_t x = load32(in + 4 * i);
-    const uint32_t y = ((x >> sy0) & 0xff) | (((x >> su) & 0xff) << 8) | (((x >> sy1) & 0xff) << 16) |
-                       (((x >> sv) & 0xff) << 24);
+    const uint32_t y = ((x >> (8 * Y0)) & 0xff) | (((x >> (8 * U)) & 0xff) << 8) | (((x >> (8 * Y1)) & 0xff) << 16) |
+                       (((x >> (8 * V)) & 0xff) << 24);
     std::memcpy(out + 4 * i, &y, 4);
   }
 }
 
+void packed_to_yuyv(const uint8_t* in, uint8_t* out, int pairs, const V4L2FrameLayout& l) {
+  if (l.y0 == 1 && l.u == 0 && l.y1 == 3 && l.v == 2) return reorder_pairs<1, 0, 3, 2>(in, out, pairs);  // UYVY
+  if (l.y0 == 0 && l.u == 3 && l.y1 == 2 && l.v == 1) return reorder_pairs<0, 3, 2, 1>(in, out, pairs);  // YVYU
+  for (int i = 0; i < pairs; ++i)
+    for (const auto& [from, to] : {std::pair{l.y0, 0}, std::pair{l.u, 1}, std::pair{l.y1, 2}, std::pair{l.v, 3}})
+      out[4 * i + to] = in[4 * i + from];
+}
+
+// U V pairs from V U pairs (NV21, NV61): a byte swap of each 16-bit word.
 void swap_pairs(const uint8_t* in, uint8_t* out, int pairs) {
   for (int i = 0; i < pairs; ++i) {
-    out[2 * i] = in[2 * i + 1];
-    out[2 * i + 1] = in[2 * i];
+    uint16_t x;
+    std::memcpy(&x, in + 2 * i, 2);
+    x = uint16_t((x << 8) | (x >> 8));
+    std::memcpy(out + 2 * i, &x, 2);
   }
 }
 
