@@ -8,6 +8,7 @@
 #include "capture/recording/recording_reader.h"
 #include "capture/sim/raw_exposure.h"
 #include "capture/sim/simulator.h"
+#include "tests/core/image/demosaic_neighbourhood.h"
 #include "core/image/bayer.h"
 #include "tests/sim/sim_test_support.h"
 
@@ -65,18 +66,7 @@ TEST(RawExposure, SimulatedBayerCaptureDevelopsToTheLinearImage) {
   double worst = 0;
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
-      double lo = 1e9, hi = -1e9;
-      for (int v = std::max(0, y - radius); v <= std::min(h - 1, y + radius); ++v)
-        for (int u = std::max(0, x - radius); u <= std::min(w - 1, x + radius); ++u)
-          for (int c = 0; c < 3; ++c) {
-            lo = std::min(lo, truth(u, v, c));
-            hi = std::max(hi, truth(u, v, c));
-          }
-      bool flat = true;
-      for (int c = 0; c < 3; ++c)
-        for (int v = std::max(0, y - radius); v <= std::min(h - 1, y + radius); ++v)
-          for (int u = std::max(0, x - radius); u <= std::min(w - 1, x + radius); ++u)
-            flat = flat && std::abs(truth(u, v, c) - truth(x, y, c)) < 1e-6;
+      const auto [lo, hi, flat] = arpipe::test::demosaic_neighbourhood(truth, x, y, w, h, radius, 1e-6);
       (flat ? flat_pixels : edge_pixels) += 1;
       for (int c = 0; c < 3; ++c) {
         const double error = std::abs(rgb[(size_t(y) * w + x) * 3 + size_t(c)] - truth(x, y, c));

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/image/bayer.h"
+#include "tests/core/image/demosaic_neighbourhood.h"
 #include "core/image/pixel_convert.h"
 #include "core/image/srgb.h"
 
@@ -240,17 +241,7 @@ TEST(BayerDevelop, DemosaicErrorOnAnEdgeChartIsWithinTheAnalyticBound) {
   size_t near_edge = 0;
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
-      double lo = 1, hi = 0;
-      for (int v = std::max(0, y - radius); v <= std::min(h - 1, y + radius); ++v)
-        for (int u = std::max(0, x - radius); u <= std::min(w - 1, x + radius); ++u)
-          for (int c = 0; c < 3; ++c) {
-            lo = std::min(lo, truth(u, v, c));
-            hi = std::max(hi, truth(u, v, c));
-          }
-      bool flat = true;
-      for (int v = std::max(0, y - radius); v <= std::min(h - 1, y + radius) && flat; ++v)
-        for (int u = std::max(0, x - radius); u <= std::min(w - 1, x + radius) && flat; ++u)
-          for (int c = 0; c < 3; ++c) flat = flat && truth(u, v, c) == truth(x, y, c);
+      const auto [lo, hi, flat] = test::demosaic_neighbourhood(truth, x, y, w, h, radius, 0.0);
       near_edge += flat ? 0 : 1;
       largest_step = std::max(largest_step, hi - lo);
       for (int c = 0; c < 3; ++c) {
