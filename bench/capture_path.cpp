@@ -29,7 +29,7 @@
 #include "bench/benchmarks.h"
 #include "capture/live/live_source.h"
 #include "capture/recording/recording_reader.h"
-#include "capture/recording/recording_writer.h"
+#include "capture/recording/recording_copy.h"
 #include "core/image/pixel_convert.h"
 #include "core/frame_memory.h"
 #include "core/log.h"
@@ -169,29 +169,12 @@ std::vector<double> latencies_ms(const fs::path& dir, const fs::path& recording,
   return ms;
 }
 
-// The recording's first frames in another format (a raw sensor's Bayer: each pixel's filter
-// channel of its linear value), so that the stand-in serves them as they are: converting them as
-// it serves would run beside the copy being measured and share the caches with it.
+// The recording's first frames in another format, so that the stand-in serves them as they are:
+// converting them as it serves would run beside the copy being measured and share the caches with it.
 fs::path format_copy(const fs::path& recording, const fs::path& dir, PixelFormat format, size_t frames) {
-  const RecordingReader reader(recording);
-  RecordingInfo info;
-  info.pixel_format = format;
-  info.width = reader.info().width;
-  info.height = reader.info().height;
-  info.source = "bench capture-path: a copy in another format";
   const fs::path out = dir / std::string(pixel_format_name(format));
   fs::remove_all(out);
-  RecordingWriter writer(out, info, reader.camera_model());
-  std::vector<uint8_t> rgb;
-  for (size_t i = 0; i < std::min(frames, reader.frame_count()); ++i) {
-    Frame frame;
-    reader.read(i, frame);
-    to_rgb24(frame, rgb);
-    Frame raw = from_rgb24(rgb.data(), frame.width, frame.height, info.pixel_format);
-    raw.meta = frame.meta;
-    writer.append(raw);
-  }
-  writer.flush();
+  copy_recording_as(recording, out, format, frames, "bench capture-path: a copy in another format");
   return out;
 }
 

@@ -33,6 +33,17 @@ int64_t exposure_start_from_raw(int64_t raw_ns, TimestampMeaning meaning, int64_
   return start + offset_ns;
 }
 
+bool Frame::reshape(PixelFormat new_format, int new_width, int new_height, size_t new_bytes_per_line) {
+  format = new_format;
+  width = new_width;
+  height = new_height;
+  bytes_per_line = new_bytes_per_line ? new_bytes_per_line : min_bytes_per_line(new_format, new_width);
+  const size_t bytes = image_bytes(format, width, height, bytes_per_line);
+  const bool allocates = data.capacity() < bytes;
+  data.resize(bytes);
+  return allocates;
+}
+
 Frame Frame::allocate(PixelFormat format, int width, int height) {
   Frame f;
   f.format = format;

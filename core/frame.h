@@ -77,6 +77,10 @@ struct Frame {
 
   // Allocates an image of this format and size with the minimum stride.
   static Frame allocate(PixelFormat format, int width, int height);
+  // Gives this frame that format, size and stride (0: the minimum), keeping its memory when it
+  // holds enough (a recycled frame, core/pipeline/frame_pool.h); its pixels are then undefined.
+  // True when the memory had to be allocated.
+  bool reshape(PixelFormat format, int width, int height, size_t bytes_per_line = 0);
   bool empty() const { return data.empty(); }
 };
 

@@ -15,20 +15,6 @@ LibcameraTiming libcamera_timing(int64_t timestamp_offset_ns, int64_t readout_ns
   return t;
 }
 
-namespace {
-
-TimestampMeaning sensor_timestamp_meaning(BufferTimestamps configured) {
-  switch (configured) {
-    case BufferTimestamps::DriverFlag:
-    case BufferTimestamps::StartOfExposure: return TimestampMeaning::StartOfExposure;
-    case BufferTimestamps::EndOfExposure: return TimestampMeaning::EndOfExposure;
-    case BufferTimestamps::EndOfFrame: return TimestampMeaning::EndOfFrame;
-  }
-  return TimestampMeaning::StartOfExposure;
-}
-
-}  // namespace
-
 std::string libcamera_missing_names(unsigned missing) {
   static constexpr struct {
     unsigned flag;
@@ -89,7 +75,7 @@ LibcameraMapped map_libcamera_metadata(const LibcameraRequestValues& values, uin
   // exposure later, per picamera2 issue 821): docs/OPERATIONS.md says how to measure and correct it.
   if (values.sensor_timestamp_ns) {
     m.raw_timestamp_ns = *values.sensor_timestamp_ns;
-    m.raw_timestamp_meaning = sensor_timestamp_meaning(timing.sensor_timestamp);
+    m.raw_timestamp_meaning = fixed_timestamp_meaning(timing.sensor_timestamp).value_or(TimestampMeaning::StartOfExposure);
   } else {
     out.missing |= kMissingSensorTimestamp;
     m.raw_timestamp_ns = buffer_timestamp_ns;

@@ -374,10 +374,7 @@ bool LibcameraStream::requeue(libcamera::Request* request, std::string& why) {
 }
 
 void LibcameraStream::copy_image(const libcamera::FrameBuffer& buffer, Frame& frame) const {
-  if (frame.format != format_.format || frame.width != format_.width || frame.height != format_.height ||
-      frame.data.size() != image_bytes(format_.format, format_.width, format_.height,
-                                       min_bytes_per_line(format_.format, format_.width)))
-    frame = Frame::allocate(format_.format, format_.width, format_.height);
+  frame.reshape(format_.format, format_.width, format_.height);  // a recycled frame's memory is reused
   const size_t row = frame.bytes_per_line;
   const auto& planes = plane_data_.at(&buffer);
   const uint8_t* src = planes[0];

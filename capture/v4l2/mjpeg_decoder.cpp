@@ -27,8 +27,7 @@ bool MjpegDecoder::decode(const uint8_t* jpeg, size_t size, int width, int heigh
     why = fmt::format("MJPEG frame is {}x{}, the stream {}x{}", jpeg_width, jpeg_height, width, height);
     return false;
   }
-  if (out.format != PixelFormat::RGB24 || out.width != width || out.height != height || out.data.empty())
-    out = Frame::allocate(PixelFormat::RGB24, width, height);
+  out.reshape(PixelFormat::RGB24, width, height);  // a recycled frame's memory is reused
   // TJFLAG_STOPONWARNING: a truncated frame (a USB packet lost) is an error, not grey rows.
   if (tjDecompress2(handle_, jpeg, static_cast<unsigned long>(size), out.data.data(), width,
                     static_cast<int>(out.bytes_per_line), height, TJPF_RGB, TJFLAG_STOPONWARNING) != 0) {

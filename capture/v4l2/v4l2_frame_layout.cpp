@@ -15,9 +15,27 @@ namespace {
 
 using Kind = V4L2FrameLayout::Kind;
 
-V4L2FrameLayout packed(uint32_t fourcc, CaptureFormat name, uint8_t y0, uint8_t u, uint8_t y1, uint8_t v) {
+uint32_t load32(const uint8_t* p) {
+  uint32_t x;
+  std::memcpy(&x, p, 4);
+  return x;
+}
+
+// Y0 U Y1 V from another order of the four bytes of each pixel pair, with the byte positions fixed
+// at compile time so that the loop is a few vector shifts and masks.
+template <unsigned Y0, unsigned U, unsigned Y1, unsigned V>
+void reorder_pairs(const uint8_t* in, uint8_t* out, int pairs) {
+  for (int i = 0; i < pairs; ++i) {
+    const uint32_t x = load32(in + 4 * i);
+    const uint32_t y = ((x >> (8 * Y0)) & 0xff) | (((x >> (8 * U)) & 0xff) << 8) | (((x >> (8 * Y1)) & 0xff) << 16) |
+                       (((x >> (8 * V)) & 0xff) << 24);
+    std::memcpy(out + 4 * i, &y, 4);
+  }
+}
+
+V4L2FrameLayout packed(uint32_t fourcc, CaptureFormat name, void (*to_yuyv)(const uint8_t*, uint8_t*, int)) {
   V4L2FrameLayout l{fourcc, name, Kind::Packed422, 1, PixelFormat::YUYV};
-  l.y0 = y0, l.u = u, l.y1 = y1, l.v = v;
+  l.to_yuyv = to_yuyv;
   return l;
 }
 V4L2FrameLayout planes(uint32_t fourcc, CaptureFormat name, Kind kind, int memory_planes, bool v_first) {
@@ -29,8 +47,8 @@ V4L2FrameLayout planes(uint32_t fourcc, CaptureFormat name, Kind kind, int memor
 
 // The formats taken by reordering; the pipeline's own come from core/pixel_format.h.
 const std::array kConverted = {
-    packed(V4L2_PIX_FMT_UYVY, CaptureFormat::UYVY, 1, 0, 3, 2),
-    packed(V4L2_PIX_FMT_YVYU, CaptureFormat::YVYU, 0, 3, 2, 1),
+    packed(V4L2_PIX_FMT_UYVY, CaptureFormat::UYVY, reorder_pairs<1, 0, 3, 2>),  // U Y0 V Y1
+    packed(V4L2_PIX_FMT_YVYU, CaptureFormat::YVYU, reorder_pairs<0, 3, 2, 1>),  // Y0 V Y1 U
     planes(V4L2_PIX_FMT_NV21, CaptureFormat::NV21, Kind::SemiPlanar420, 1, true),
     planes(V4L2_PIX_FMT_YUV420, CaptureFormat::YUV420, Kind::Planar420, 1, false),
     planes(V4L2_PIX_FMT_NV16, CaptureFormat::NV16, Kind::SemiPlanar422, 1, false),
@@ -75,32 +93,6 @@ bool locate(std::span<const V4L2Plane> planes, int memory_planes, int index, siz
   return true;
 }
 
-uint32_t load32(const uint8_t* p) {
-  uint32_t x;
-  std::memcpy(&x, p, 4);
-  return x;
-}
-
-// Y0 U Y1 V from another order of the four bytes of each pixel pair, with the byte positions fixed
-// at compile time so that the loop is a few vector shifts and masks.
-template <unsigned Y0, unsigned U, unsigned Y1, unsigned V>
-void reorder_pairs(const uint8_t* in, uint8_t* out, int pairs) {
-  for (int i = 0; i < pairs; ++i) {
-    const uint32_t x = load32(in + 4 * i);
-    const uint32_t y = ((x >> (8 * Y0)) & 0xff) | (((x >> (8 * U)) & 0xff) << 8) | (((x >> (8 * Y1)) & 0xff) << 16) |
-                       (((x >> (8 * V)) & 0xff) << 24);
-    std::memcpy(out + 4 * i, &y, 4);
-  }
-}
-
-void packed_to_yuyv(const uint8_t* in, uint8_t* out, int pairs, const V4L2FrameLayout& l) {
-  if (l.y0 == 1 && l.u == 0 && l.y1 == 3 && l.v == 2) return reorder_pairs<1, 0, 3, 2>(in, out, pairs);  // UYVY
-  if (l.y0 == 0 && l.u == 3 && l.y1 == 2 && l.v == 1) return reorder_pairs<0, 3, 2, 1>(in, out, pairs);  // YVYU
-  for (int i = 0; i < pairs; ++i)
-    for (const auto& [from, to] : {std::pair{l.y0, 0}, std::pair{l.u, 1}, std::pair{l.y1, 2}, std::pair{l.v, 3}})
-      out[4 * i + to] = in[4 * i + from];
-}
-
 // U V pairs from V U pairs (NV21, NV61): a byte swap of each 16-bit word.
 void swap_pairs(const uint8_t* in, uint8_t* out, int pairs) {
   for (int i = 0; i < pairs; ++i) {
@@ -109,18 +101,6 @@ void swap_pairs(const uint8_t* in, uint8_t* out, int pairs) {
     x = uint16_t((x << 8) | (x >> 8));
     std::memcpy(out + 2 * i, &x, 2);
   }
-}
-
-// Sizes the frame for `format` at the given stride, keeping its memory when it holds enough.
-uint8_t* prepare(Frame& frame, PixelFormat format, int width, int height, size_t bytes_per_line, bool& allocated) {
-  const size_t bytes = image_bytes(format, width, height, bytes_per_line);
-  allocated = frame.data.capacity() < bytes;
-  frame.data.resize(bytes);
-  frame.format = format;
-  frame.width = width;
-  frame.height = height;
-  frame.bytes_per_line = bytes_per_line;
-  return frame.data.data();
 }
 
 }  // namespace
@@ -165,8 +145,8 @@ bool fill_frame_from_v4l2(const V4L2FrameLayout& l, std::span<const V4L2Plane> p
       why = fmt::format("{} bytes, a frame needs {}", planes[0].bytes_used, bytes);
       return false;
     }
-    uint8_t* out = prepare(frame, l.frame_format, width, height, stride, allocated);
-    std::memcpy(out, planes[0].data, bytes);
+    allocated = frame.reshape(l.frame_format, width, height, stride);
+    std::memcpy(frame.data.data(), planes[0].data, bytes);
     return true;
   }
 
@@ -187,10 +167,11 @@ bool fill_frame_from_v4l2(const V4L2FrameLayout& l, std::span<const V4L2Plane> p
     return false;
   }
   const size_t out_stride = min_bytes_per_line(l.frame_format, width);
-  uint8_t* out = prepare(frame, l.frame_format, width, height, out_stride, allocated);
+  allocated = frame.reshape(l.frame_format, width, height, out_stride);
+  uint8_t* out = frame.data.data();
   switch (l.kind) {
     case Kind::Packed422:
-      for (size_t r = 0; r < h; ++r) packed_to_yuyv(y.data + r * y.stride, out + r * out_stride, width / 2, l);
+      for (size_t r = 0; r < h; ++r) l.to_yuyv(y.data + r * y.stride, out + r * out_stride, width / 2);
       break;
     case Kind::SemiPlanar420:
     case Kind::Planar420: {

@@ -31,9 +31,9 @@ struct V4L2FrameLayout {
   Kind kind = Kind::AsIs;
   int memory_planes = 1;           // buffers per frame the driver fills (2 or 3 for the "M" formats)
   PixelFormat frame_format = PixelFormat::RGB24;
-  // Packed422: the byte offsets of Y0, U, Y1, V in each 4-byte pair. Semi-planar: whether the
+  // Packed422: turns a row of `pairs` pixel pairs into Y0 U Y1 V order. Semi-planar: whether the
   // chroma pairs are V, U (NV21, NV61). Planar: whether V's plane comes before U's (YVU420).
-  uint8_t y0 = 0, u = 1, y1 = 2, v = 3;
+  void (*to_yuyv)(const uint8_t* in, uint8_t* out, int pairs) = nullptr;
   bool v_first = false;
 };
 

@@ -40,9 +40,7 @@ int64_t timeval_ns(const timeval& tv) { return int64_t(tv.tv_sec) * 1'000'000'00
 
 // The driver's TSTAMP_SRC flag, unless the config overrides it (drivers disagree with their flags).
 TimestampMeaning timestamp_meaning(uint32_t flags, BufferTimestamps configured) {
-  if (configured == BufferTimestamps::StartOfExposure) return TimestampMeaning::StartOfExposure;
-  if (configured == BufferTimestamps::EndOfFrame) return TimestampMeaning::EndOfFrame;
-  if (configured == BufferTimestamps::EndOfExposure) return TimestampMeaning::EndOfExposure;
+  if (const auto fixed = fixed_timestamp_meaning(configured)) return *fixed;
   return (flags & V4L2_BUF_FLAG_TSTAMP_SRC_MASK) == V4L2_BUF_FLAG_TSTAMP_SRC_SOE ? TimestampMeaning::StartOfExposure
                                                                                  : TimestampMeaning::EndOfFrame;
 }
@@ -299,24 +297,20 @@ class V4L2Stream final : public CameraStream {
       }
       in[p] = {buffers_->data(buffer.index, p) + offset, used - offset, bytes_per_line_[p]};
     }
-    bool allocated = false;
+    bool allocated = false, filled = false;
     if (mjpeg_) {
-      allocated = frame.data.capacity() < size_t(format_.width) * size_t(format_.height) * 3;
-      if (!decoder_->decode(in[0].data, in[0].bytes_used, format_.width, format_.height, frame, why)) {
-        count([](StreamCounters& c) { ++c.error_buffers; });
-        why = fmt::format("{}: sequence {}: {}", settings_.device, buffer.sequence, why);
-        return StreamStatus::Again;
-      }
+      const size_t capacity = frame.data.capacity();  // grows only by allocating
+      filled = decoder_->decode(in[0].data, in[0].bytes_used, format_.width, format_.height, frame, why);
+      allocated = frame.data.capacity() > capacity;
     } else {
-      if (!fill_frame_from_v4l2(layout_, std::span(in, memory_planes_), format_.width, format_.height, frame,
-                                allocated, why)) {
-        count([](StreamCounters& c) { ++c.error_buffers; });
-        why = fmt::format("{}: sequence {}: {}", settings_.device, buffer.sequence, why);
-        return StreamStatus::Again;
-      }
-      count([](StreamCounters& c) { ++c.copies; });
+      filled = fill_frame_from_v4l2(layout_, std::span(in, memory_planes_), format_.width, format_.height, frame,
+                                    allocated, why);
     }
-    if (allocated) count([](StreamCounters& c) { ++c.frame_allocations; });
+    if (!filled) {
+      count([](StreamCounters& c) { ++c.error_buffers; });
+      why = fmt::format("{}: sequence {}: {}", settings_.device, buffer.sequence, why);
+      return StreamStatus::Again;
+    }
     if ((buffer.flags & V4L2_BUF_FLAG_TIMESTAMP_MASK) != V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC && !warned_clock_) {
       log::warn("{}: buffer timestamps are not on CLOCK_MONOTONIC (flags {:#x}); used as they are", settings_.device,
                 buffer.flags);
@@ -335,7 +329,11 @@ class V4L2Stream final : public CameraStream {
     m.timestamp_offset_ns = settings_.timestamp_offset_ns;
     m.exposure_start_ns = exposure_start_from_raw(m.raw_timestamp_ns, m.raw_timestamp_meaning, m.exposure_ns,
                                                   m.readout_ns, m.timestamp_offset_ns);
-    count([](StreamCounters& c) { ++c.frames; });
+    count([&](StreamCounters& c) {
+      ++c.frames;
+      c.copies += mjpeg_ ? 0 : 1;
+      c.frame_allocations += allocated ? 1 : 0;
+    });
     return StreamStatus::Frame;
   }
 

@@ -6,6 +6,7 @@
 #include <optional>
 
 #include "core/config/choice_names.h"
+#include "core/frame.h"
 #include "core/pixel_format.h"
 
 namespace arpipe {
@@ -69,5 +70,16 @@ inline constexpr ChoiceName<BufferTimestamps> kBufferTimestampsNames[] = {
     {"start-of-exposure", BufferTimestamps::StartOfExposure},
     {"end-of-exposure", BufferTimestamps::EndOfExposure},
     {"end-of-frame", BufferTimestamps::EndOfFrame}};
+
+// The meaning a configured value fixes; nullopt for "auto" (what the camera says).
+inline std::optional<TimestampMeaning> fixed_timestamp_meaning(BufferTimestamps configured) {
+  switch (configured) {
+    case BufferTimestamps::DriverFlag: return std::nullopt;
+    case BufferTimestamps::StartOfExposure: return TimestampMeaning::StartOfExposure;
+    case BufferTimestamps::EndOfExposure: return TimestampMeaning::EndOfExposure;
+    case BufferTimestamps::EndOfFrame: return TimestampMeaning::EndOfFrame;
+  }
+  return std::nullopt;
+}
 
 }  // namespace arpipe

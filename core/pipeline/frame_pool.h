@@ -21,7 +21,6 @@ class FramePool {
     if (kept_.empty()) return {};
     std::vector<uint8_t> bytes = std::move(kept_.back());
     kept_.pop_back();
-    ++reused_;
     return bytes;
   }
   void give(std::vector<uint8_t>&& bytes) {
@@ -29,16 +28,11 @@ class FramePool {
     std::lock_guard lock(mutex_);
     if (kept_.size() < keep_) kept_.push_back(std::move(bytes));
   }
-  uint64_t reused() const {
-    std::lock_guard lock(mutex_);
-    return reused_;
-  }
 
  private:
   const size_t keep_;
-  mutable std::mutex mutex_;
+  std::mutex mutex_;
   std::vector<std::vector<uint8_t>> kept_;
-  uint64_t reused_ = 0;
 };
 
 }  // namespace arpipe

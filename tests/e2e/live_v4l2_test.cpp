@@ -9,8 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "capture/recording/recording_reader.h"
-#include "capture/recording/recording_writer.h"
-#include "core/image/pixel_convert.h"
+#include "capture/recording/recording_copy.h"
 #include "tests/e2e/child_process.h"
 #include "tests/e2e/default_capture_truth.h"
 
@@ -156,24 +155,9 @@ namespace {
 // The default capture's first `frames` frames as a raw sensor would give them: each pixel's CFA
 // channel (GRBG, MIPI-packed 10-bit) of its linear value, with the ground truth.
 fs::path bayer_copy_of_default_capture(const fs::path& dir, size_t frames) {
-  const RecordingReader reader(kCapture);
-  RecordingInfo info;
-  info.pixel_format = PixelFormat::SGRBG10P;
-  info.width = reader.info().width;
-  info.height = reader.info().height;
-  info.source = "the default capture as a GRBG 10-bit MIPI-packed raw sensor";
   const fs::path out = dir / "bayer-capture";
-  RecordingWriter writer(out, info, reader.camera_model());
-  std::vector<uint8_t> rgb;
-  for (size_t i = 0; i < frames; ++i) {
-    Frame frame;
-    reader.read(i, frame);
-    to_rgb24(frame, rgb);
-    Frame raw = from_rgb24(rgb.data(), frame.width, frame.height, PixelFormat::SGRBG10P);
-    raw.meta = frame.meta;
-    writer.append(raw, reader.ground_truth()[i]);
-  }
-  writer.flush();
+  copy_recording_as(kCapture, out, PixelFormat::SGRBG10P, frames,
+                    "the default capture as a GRBG 10-bit MIPI-packed raw sensor");
   return out;
 }
 
