@@ -29,6 +29,7 @@
 #include "bench/benchmarks.h"
 #include "capture/live/live_source.h"
 #include "capture/recording/recording_reader.h"
+#include "capture/raw_colour_source.h"
 #include "capture/recording/recording_copy.h"
 #include "core/image/pixel_convert.h"
 #include "core/frame_memory.h"
@@ -190,6 +191,23 @@ double develop_ms(const fs::path& bayer, int repeats) {
   return double(monotonic_now_ns() - start) * 1e-6 / repeats;
 }
 
+// ms to measure one raw frame's grey-world gains as it leaves the source (a camera that says none:
+// capture/raw_colour_source.h), the mean of `repeats`.
+double grey_world_ms(const fs::path& bayer, int repeats) {
+  const RecordingReader reader(bayer);
+  Frame raw;
+  reader.read(0, raw);
+  RawColourResolver resolver{RawColourConfig{}};
+  raw.meta.raw = RawColour{};
+  resolver.resolve(raw);  // warm-up (and its one log line)
+  const int64_t start = monotonic_now_ns();
+  for (int i = 0; i < repeats; ++i) {
+    raw.meta.raw = RawColour{};
+    resolver.resolve(raw);
+  }
+  return double(monotonic_now_ns() - start) * 1e-6 / repeats;
+}
+
 struct CapturePathOptions {
   fs::path recording = fs::path(ARPIPE_BINARY_DIR) / "default-capture";
   int frames = 300;
@@ -262,6 +280,8 @@ int run_capture_path_benchmark(const CapturePathOptions& options) {
     }
     fmt::print("\nSGRBG10P developed to RGB24 where the pixels are read (black level, white balance, OpenCV's "
                "edge-aware demosaic, sRGB; core/image/bayer.h): {:.2f} ms a frame\n", develop_ms(bayer, 20));
+    fmt::print("SGRBG10P grey-world gains measured as the frame leaves the source, for a camera that says none "
+               "(capture/raw_colour_source.h): {:.2f} ms a frame\n", grey_world_ms(bayer, 20));
     const auto ms = latencies_ms(dir, recording, std::min(frames, 90));
     const auto at = [&](double q) { return ms[std::min(ms.size() - 1, size_t(q * double(ms.size())))]; };
     fmt::print("\nexposure end to hand-off (real-time pacing, {} frames): median {:.3f} ms, p90 {:.3f} ms, max {:.3f} ms\n",

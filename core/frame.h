@@ -10,6 +10,7 @@
 #include "core/geometry/ods_projection.h"
 #include "core/geometry/se3.h"
 #include "core/pixel_format.h"
+#include "core/raw_colour.h"
 #include "core/sh/sh_basis.h"
 
 namespace arpipe {
@@ -56,6 +57,8 @@ struct FrameMetadata {
   // The whole light around the camera, when the source holds it (a panorama, which is its own
   // environment): radiance SH in the world frame, scene-linear (light.source = "panorama").
   std::optional<ShRgb9> environment_sh;
+  // How a raw Bayer frame develops into light (core/raw_colour.h); unused for other formats.
+  RawColour raw;
 
   // Middle of the exposure of the middle row: where a single pose for the frame belongs.
   int64_t exposure_mid_ns() const { return exposure_start_ns + (exposure_ns + readout_ns) / 2; }

@@ -4,6 +4,7 @@
 
 #include "capture/live/live_source.h"
 #include "capture/panorama/panorama_source.h"
+#include "capture/raw_colour_source.h"
 #include "capture/replay_source.h"
 #include "capture/sinks/gstreamer/gstreamer_sink.h"
 #include "capture/sinks/http/http_sink.h"
@@ -23,9 +24,12 @@ namespace arpipe {
 
 std::unique_ptr<FrameSource> make_source(const Config& config) {
   switch (config.source.type) {
-    case SourceType::Replay: return std::make_unique<ReplaySource>(config.source);
+    // Raw Bayer frames leave the source with their development decided ([source.raw]).
+    case SourceType::Replay:
+      return std::make_unique<RawColourSource>(std::make_unique<ReplaySource>(config.source), config.source.raw);
     case SourceType::V4l2:
-    case SourceType::Libcamera: return make_live_source(config.source);
+    case SourceType::Libcamera:
+      return std::make_unique<RawColourSource>(make_live_source(config.source), config.source.raw);
     case SourceType::Panorama:
       return std::make_unique<PanoramaSource>(config.source, config.light.source == LightSource::Panorama);
   }

@@ -53,6 +53,14 @@ LibcameraRequestValues read_request_values(const libcamera::ControlList& metadat
   if (auto x = metadata.get(c::FrameDuration)) v.frame_duration_us = static_cast<int64_t>(*x);
   if (auto x = metadata.get(c::Lux)) v.lux = static_cast<double>(*x);
   if (auto x = metadata.get(c::ColourTemperature)) v.colour_temperature_k = static_cast<double>(*x);
+  if (auto x = metadata.get(c::SensorBlackLevels); x && x->size() == 4)
+    v.sensor_black_levels_16bit = std::array<double, 4>{double((*x)[0]), double((*x)[1]), double((*x)[2]), double((*x)[3])};
+  if (auto x = metadata.get(c::ColourGains); x && x->size() == 2)
+    v.colour_gains_rb = std::array<double, 2>{double((*x)[0]), double((*x)[1])};
+  if (auto x = metadata.get(c::ColourCorrectionMatrix); x && x->size() == 9) {
+    std::array<double, 9>& m = v.colour_correction_matrix.emplace();
+    for (size_t i = 0; i < 9; ++i) m[i] = double((*x)[i]);
+  }
   return v;
 }
 

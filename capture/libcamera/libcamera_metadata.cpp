@@ -66,6 +66,16 @@ LibcameraMapped map_libcamera_metadata(const LibcameraRequestValues& values, uin
   m.readout_ns = timing.readout_ns;
   m.lux = values.lux.value_or(0.0);
   m.colour_temperature_k = values.colour_temperature_k.value_or(0.0);
+  if (timing.raw_bit_depth > 0) {  // a raw stream: how its values develop (core/raw_colour.h)
+    if (values.sensor_black_levels_16bit) {
+      const double scale = double(1 << timing.raw_bit_depth) / 65536.0;
+      std::array<double, 4>& black = m.raw.black_level.emplace();
+      for (size_t i = 0; i < 4; ++i) black[i] = (*values.sensor_black_levels_16bit)[i] * scale;
+    }
+    if (values.colour_gains_rb)
+      m.raw.gains = std::array<double, 3>{(*values.colour_gains_rb)[0], 1.0, (*values.colour_gains_rb)[1]};
+    m.raw.colour_matrix = values.colour_correction_matrix;
+  }
 
   // libcamera documents SensorTimestamp as "the time when the first row of the image sensor active
   // array is exposed" (control_ids.yaml), i.e. docs/DESIGN.md's exposure start. Its clock is documented

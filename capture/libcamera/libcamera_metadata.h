@@ -2,6 +2,7 @@
 // FrameMetadata. No libcamera types here, so the mapping is tested without a camera.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -21,6 +22,12 @@ struct LibcameraRequestValues {
   std::optional<int64_t> frame_duration_us;    // controls::FrameDuration
   std::optional<double> lux;                   // controls::Lux
   std::optional<double> colour_temperature_k;  // controls::ColourTemperature
+  // What the pipeline's own processing used, reported on raw streams too: R, Gr, Gb, B at a
+  // 16-bit scale (controls::SensorBlackLevels); red and blue gains (controls::ColourGains); the
+  // camera-RGB-to-sRGB matrix, row-major (controls::ColourCorrectionMatrix).
+  std::optional<std::array<double, 4>> sensor_black_levels_16bit;
+  std::optional<std::array<double, 2>> colour_gains_rb;
+  std::optional<std::array<double, 9>> colour_correction_matrix;
 };
 
 // What the config says about this camera, used where the request says nothing.
@@ -33,6 +40,8 @@ struct LibcameraTiming {
   // source.timestamp_meaning: what SensorTimestamp means on this board (auto: as documented, the
   // first row's start of exposure; Raspberry Pi's pipeline is said to stamp its end).
   BufferTimestamps sensor_timestamp = BufferTimestamps::DriverFlag;
+  // The stream's bit depth when it is raw Bayer (SensorBlackLevels is scaled to it); 0 otherwise.
+  int raw_bit_depth = 0;
 };
 LibcameraTiming libcamera_timing(int64_t timestamp_offset_ns, int64_t readout_ns, int64_t exposure_us,
                                  double gain, double fps);

@@ -211,10 +211,10 @@ void LibcameraStream::configure(const SourceConfig& config) {
   std::optional<PixelFormat> wanted_format;
   if (config.pixel_format != CaptureFormat::Auto) {
     wanted_format = frame_format(config.pixel_format);
-    if (wanted_format && !libcamera_pixel_format(*wanted_format).isValid()) wanted_format.reset();  // raw Bayer
+    if (wanted_format && !libcamera_pixel_format(*wanted_format).isValid()) wanted_format.reset();  // MJPG and the V4L2 reorderings
     if (!wanted_format)
       throw CameraError(Kind::Refused, fmt::format("libcamera camera '{}': pixel format {} is not one arpipe takes "
-                                                   "from libcamera (RGB24, YUYV, NV12, GREY); the camera offers {}",
+                                                   "from libcamera (RGB24, YUYV, NV12, GREY, raw Bayer); the camera offers {}",
                                                    camera_id_, choice_name(kCaptureFormatNames, config.pixel_format),
                                                    offered));
     sc.pixelFormat = libcamera_pixel_format(*wanted_format);
@@ -222,7 +222,7 @@ void LibcameraStream::configure(const SourceConfig& config) {
     auto preferred = preferred_libcamera_format(sc.formats().pixelformats());
     if (!preferred)
       throw CameraError(Kind::Refused, fmt::format("libcamera camera '{}': offers no format arpipe takes (RGB24, "
-                                                   "YUYV, NV12, GREY); it offers {}",
+                                                   "YUYV, NV12, GREY, raw Bayer); it offers {}",
                                                    camera_id_, offered));
     sc.pixelFormat = libcamera_pixel_format(*preferred);
   }
@@ -260,6 +260,7 @@ void LibcameraStream::configure(const SourceConfig& config) {
                                                  camera_id_, sc.pixelFormat.toString()));
   format_.format = *ours;
   format_.camera_format = sc.pixelFormat.toString();
+  timing_.raw_bit_depth = is_bayer(*ours) ? bayer_bit_depth(*ours) : 0;
   format_.width = static_cast<int>(sc.size.width);
   format_.height = static_cast<int>(sc.size.height);
   format_.frame_interval_ns = config.fps > 0 ? static_cast<int64_t>(1e9 / config.fps + 0.5) : 0;

@@ -26,7 +26,9 @@ void copy_recording_as(const std::filesystem::path& from, const std::filesystem:
     reader.read(i, frame);
     to_rgb24(frame, rgb);
     Frame copy = from_rgb24(rgb.data(), frame.width, frame.height, format);
+    const RawColour raw = copy.meta.raw;  // how from_rgb24 coded a Bayer copy
     copy.meta = frame.meta;
+    copy.meta.raw = raw;
     writer.append(copy, i < truth.size() ? std::optional(truth[i]) : std::nullopt);
   }
   writer.flush();

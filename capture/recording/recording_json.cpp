@@ -4,7 +4,10 @@
 
 #include <fmt/format.h>
 
+#include <array>
+#include <cmath>
 #include <limits>
+#include <optional>
 #include <nlohmann/json.hpp>
 
 namespace arpipe::recording_json {
@@ -67,6 +70,23 @@ double get_double(const json& object, const char* name, const std::string& where
   const json& value = field(object, name, where, expected);
   if (!value.is_number()) wrong_type(name, value, where, expected);
   return value.get<double>();
+}
+
+// An optional array of exactly N finite numbers, each at least `lowest` (or above it when `strictly`).
+template <size_t N>
+std::optional<std::array<double, N>> get_numbers(const json& object, const char* name, const std::string& where,
+                                                 double lowest, bool strictly, const char* expected) {
+  if (!object.contains(name)) return std::nullopt;
+  const json& v = object[name];
+  if (!v.is_array() || v.size() != N) wrong_type(name, v, where, expected);
+  std::array<double, N> out{};
+  for (size_t i = 0; i < N; ++i) {
+    if (!v[i].is_number()) wrong_type(name, v, where, expected);
+    out[i] = v[i].get<double>();
+    if (!std::isfinite(out[i]) || out[i] < lowest || (strictly && out[i] == lowest))
+      throw RecordingError(fmt::format("{}: {}[{}] is {}, expected {}", where, name, i, out[i], expected));
+  }
+  return out;
 }
 
 std::string get_string(const json& object, const char* name, const std::string& where, const char* expected) {
@@ -227,6 +247,11 @@ std::string encode_frame_record(const FrameRecord& r) {
   // What the camera measured, only when it said (libcamera's Lux and ColourTemperature).
   if (m.lux > 0) j["lux"] = m.lux;
   if (m.colour_temperature_k > 0) j["colour_temperature_k"] = m.colour_temperature_k;
+  // How a raw Bayer frame develops (core/raw_colour.h), as far as the camera or the source decided.
+  if (m.raw.black_level) j["black_level"] = *m.raw.black_level;
+  if (m.raw.white_level > 0) j["white_level"] = m.raw.white_level;
+  if (m.raw.gains) j["colour_gains"] = *m.raw.gains;
+  if (m.raw.colour_matrix) j["colour_matrix"] = *m.raw.colour_matrix;
   return j.dump();
 }
 
@@ -258,6 +283,13 @@ FrameRecord decode_frame_record(const std::string& line, const std::string& wher
     m.colour_temperature_k = get_double(j, "colour_temperature_k", where, "a colour temperature in kelvin");
   if (m.lux < 0 || m.colour_temperature_k < 0)
     throw RecordingError(fmt::format("{}: lux and colour_temperature_k must not be negative", where));
+  // Their fit to the frame's bit depth is checked where the frame is developed (capture/raw_colour_source.h).
+  m.raw.black_level = get_numbers<4>(j, "black_level", where, 0, false, "4 raw codes (R, Gr, Gb, B), each >= 0");
+  if (j.contains("white_level")) m.raw.white_level = get_double(j, "white_level", where, "the raw code of full scale");
+  if (!(m.raw.white_level >= 0 && m.raw.white_level <= 65535))
+    throw RecordingError(fmt::format("{}: white_level is {}, expected a raw code in [0, 65535]", where, m.raw.white_level));
+  m.raw.gains = get_numbers<3>(j, "colour_gains", where, 0, true, "3 gains (R, G, B), each > 0");
+  m.raw.colour_matrix = get_numbers<9>(j, "colour_matrix", where, -1e300, false, "9 finite numbers, row-major");
   if (m.exposure_ns < 0 || m.readout_ns < 0 || m.frame_duration_ns < 0)
     throw RecordingError(fmt::format("{}: exposure_ns, readout_ns and frame_duration_ns must not be negative", where));
   // Every later stage adds these (exposure end, next frame's start): the sum must stay in int64 ns.

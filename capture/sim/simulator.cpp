@@ -245,6 +245,11 @@ SimulateSummary simulate(const SimScene& scene, const SimulateOptions& options) 
                       ? expose_bayer(radiance, sensor, exposure, seed, index, camera.pixel_format, camera.sensor.black_level)
                       : to_frame(expose(radiance, sensor, exposure, seed, index), width, height, camera.pixel_format, meta);
     frame.meta = meta;
+    // The simulated sensor's raw values are neutral: what its black level is, and unit gains.
+    if (is_bayer(camera.pixel_format)) {
+      frame.meta.raw.black_level.emplace().fill(double(camera.sensor.black_level));
+      frame.meta.raw.gains = std::array<double, 3>{1, 1, 1};
+    }
     writer.append(frame, truth);
     if (composite_world) {
       render_frame(renderer, camera, *composite_world, poses, meta, start_s, index, composite_radiance, &coverage);

@@ -19,6 +19,7 @@
 #include "core/config/panorama_config.h"
 #include "core/config/physics_choices.h"
 #include "core/config/proxy_roles.h"
+#include "core/config/raw_colour_config.h"
 #include "core/config/probe_kind.h"
 #include "core/config/probe_method.h"
 #include "core/config/shadow_method.h"
@@ -64,6 +65,7 @@ struct SourceConfig {
   int64_t reconnect_min_ms = 100;       // first retry after a camera disappeared
   int64_t reconnect_max_ms = 5000;      // retries back off up to this
   PanoramaConfig panorama;              // type = "panorama"
+  RawColourConfig raw;                  // raw Bayer frames: black level, white balance, colour matrix
 
   bool operator==(const SourceConfig&) const = default;
 };
@@ -101,6 +103,7 @@ void visit(V& v, SourceConfig& s) {
   v.key("reconnect_min_ms", s.reconnect_min_ms, IntRange{1, 600'000}, "first retry after the camera went away");
   v.key("reconnect_max_ms", s.reconnect_max_ms, IntRange{1, 3'600'000}, "retries back off up to this (>= reconnect_min_ms)");
   v.section("panorama", s.panorama, "type = \"panorama\": a 360° still seen through a turning view camera");
+  v.section("raw", s.raw, "raw Bayer frames (any source): how their codes become light");
 }
 
 // One tag of the anchor bundle: where its centre sits in the world (anchor) frame and how it is turned.

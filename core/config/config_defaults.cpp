@@ -63,6 +63,11 @@ class RowWriter {
   void key(std::string_view name, double value_rad, const Degrees& rule, std::string_view help) {
     row(name, toml_float(value_rad * kDegreesPerRadian), range_text(rule.range), help);
   }
+  void key(std::string_view name, const std::vector<double>& values, const NumberCount& rule, std::string_view help) {
+    std::string text = "[";
+    for (size_t i = 0; i < values.size(); ++i) text += (i ? ", " : "") + toml_float(values[i]);
+    row(name, text + "]", rule.phrase + (range_text(rule.range).empty() ? "" : ", each " + range_text(rule.range)), help);
+  }
   void key(std::string_view name, const Vec3& value_rad, const Degrees& rule, std::string_view help) {
     row(name, vec_text(kDegreesPerRadian * value_rad), range_text(rule.range) + (rule.range.interval.empty() ? "" : " each"), help);
   }

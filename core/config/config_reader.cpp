@@ -43,6 +43,16 @@ void check_cross_keys(const TomlSection& t, SourceConfig& s) {
            fmt::format("at least reconnect_min_ms ({})", s.reconnect_min_ms), fmt::format("{}", s.reconnect_max_ms));
 }
 
+void check_cross_keys(const TomlSection& t, RawColourConfig& s) {
+  if (s.white_level > 0)
+    for (double black : s.black_level)
+      if (!(black < s.white_level))
+        t.fail("black_level", fmt::format("codes below white_level ({})", s.white_level), fmt::format("{}", black));
+  // The defaults document writes unit gains with every mode; other gains would be silently unused.
+  if (s.gains != Vec3{1, 1, 1} && s.white_balance != WhiteBalanceMode::Fixed)
+    t.fail_with("gains", "expected white_balance = \"fixed\" with gains other than [1, 1, 1] (they are used only then)");
+}
+
 void check_cross_keys(const TomlSection& t, PanoramaViewpoint& s) {
   if (s.file.empty()) t.fail_with("file", "expected the viewpoint's panorama file");
 }
@@ -157,6 +167,13 @@ class RowReader {
   }
   void key(std::string_view name, Vec3& member, const NumberRange& range, std::string_view) {
     member = t_.vec3(name, member, range);
+  }
+  void key(std::string_view name, std::vector<double>& member, const NumberCount& rule, std::string_view) {
+    if (!t_.has(name)) return t_.allow(name);
+    const std::vector<double> values = t_.number_list(name, {}, rule.range, 64);
+    if (std::find(rule.counts.begin(), rule.counts.end(), values.size()) == rule.counts.end())
+      t_.fail(name, rule.phrase, fmt::format("{} numbers", values.size()));
+    member = values;
   }
   void key(std::string_view name, double& member_rad, const Degrees& rule, std::string_view) {
     if (!t_.has(name)) return t_.allow(name);  // the default stays bit for bit

@@ -44,4 +44,12 @@ struct MillisecondsAsNs {
   NumberRange range;
 };
 
+// A list of numbers whose length is one of `counts` (0 allowed when the empty list means "not
+// set"), each in range; phrase says what the list is ("[] or 1 or 4 raw codes").
+struct NumberCount {
+  std::vector<size_t> counts;
+  NumberRange range;
+  std::string phrase;
+};
+
 }  // namespace arpipe

@@ -39,6 +39,35 @@ const std::array<uint8_t, 65536>& srgb_lut() {
 
 }  // namespace
 
+BayerDevelopment bayer_development(const RawColour& raw) {
+  BayerDevelopment d;
+  d.black_level = raw.black_level.value_or(std::array<double, 4>{0, 0, 0, 0});
+  d.white_level = raw.white_level;
+  d.grey_world = !raw.gains;
+  if (raw.gains) d.white_balance = *raw.gains;
+  d.colour_matrix = raw.colour_matrix;
+  return d;
+}
+
+std::string raw_colour_problem(const RawColour& raw, PixelFormat format) {
+  const double top = double((1 << bayer_bit_depth(format)) - 1);
+  const double white = raw.white_level > 0 ? raw.white_level : top;
+  if (!std::isfinite(raw.white_level) || raw.white_level < 0 || white > top)
+    return fmt::format("the white level {} is not a code of the {}-bit format (0 means {})", raw.white_level,
+                       bayer_bit_depth(format), top);
+  if (raw.black_level)
+    for (double black : *raw.black_level)
+      if (!std::isfinite(black) || black < 0 || !(black < white))
+        return fmt::format("the black level {} is not a code below the white level {}", black, white);
+  if (raw.gains)
+    for (double g : *raw.gains)
+      if (!std::isfinite(g) || !(g > 0)) return fmt::format("the white-balance gain {} is not a positive number", g);
+  if (raw.colour_matrix)
+    for (double m : *raw.colour_matrix)
+      if (!std::isfinite(m)) return fmt::format("the colour matrix entry {} is not a finite number", m);
+  return {};
+}
+
 void normalise_bayer(const BayerMosaic& mosaic, const BayerDevelopment& development, std::vector<float>& out) {
   const double white = development.white_level > 0 ? development.white_level : double((1 << mosaic.bit_depth) - 1);
   std::array<float, 4> offset{}, scale{};

@@ -5,10 +5,12 @@
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "core/frame.h"
 #include "core/image/bayer_mosaic.h"
+#include "core/raw_colour.h"
 
 namespace arpipe {
 
@@ -26,6 +28,14 @@ struct BayerDevelopment {
   // Row-major 3x3 from white-balanced camera RGB to output RGB (e.g. a sensor's CCM), when known.
   std::optional<std::array<double, 9>> colour_matrix;
 };
+
+// The development a frame's RawColour asks for: its black and white levels, its gains (grey world
+// when it has none), its colour matrix.
+BayerDevelopment bayer_development(const RawColour& raw);
+
+// Why `raw` cannot develop a frame of `format` (a black level not below the white level, a gain
+// that is not a positive finite number, a matrix entry that is not finite); empty when it can.
+std::string raw_colour_problem(const RawColour& raw, PixelFormat format);
 
 // One value a pixel, (raw - black) / (white - black): 0 is black, 1 is the white level. Not
 // clipped, so read noise below black stays negative and its mean unbiased.

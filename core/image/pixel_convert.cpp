@@ -29,7 +29,7 @@ void to_grey(const Frame& f, const PixelRect& rect, std::vector<uint8_t>& out) {
     // Demosaicing needs the neighbours, so the whole frame is developed and the rect's luma taken
     // from it: the same luma as the frame's RGB24 would give.
     thread_local std::vector<uint8_t> rgb;
-    bayer_to_rgb24(f, BayerDevelopment{}, rgb);
+    bayer_to_rgb24(f, bayer_development(f.meta.raw), rgb);
     for (int y = r.y; y < r.bottom(); ++y)
       for (int x = r.x; x < r.right(); ++x) {
         const uint8_t* p = &rgb[(size_t(y) * f.width + x) * 3];
@@ -56,7 +56,7 @@ void to_grey(const Frame& f, const PixelRect& rect, std::vector<uint8_t>& out) {
 
 void to_rgb24(const Frame& f, std::vector<uint8_t>& out) {
   if (is_bayer(f.format)) {
-    bayer_to_rgb24(f, BayerDevelopment{}, out);
+    bayer_to_rgb24(f, bayer_development(f.meta.raw), out);
     return;
   }
   out.resize(size_t(f.width) * f.height * 3);
@@ -95,7 +95,12 @@ Frame rgb24_to_bayer(const uint8_t* rgb, int width, int height, PixelFormat form
 }  // namespace
 
 Frame from_rgb24(const uint8_t* rgb, int width, int height, PixelFormat format) {
-  if (is_bayer(format)) return rgb24_to_bayer(rgb, width, height, format);
+  if (is_bayer(format)) {
+    Frame out = rgb24_to_bayer(rgb, width, height, format);
+    out.meta.raw.black_level = std::array<double, 4>{0, 0, 0, 0};  // what rgb24_to_bayer codes: neutral
+    out.meta.raw.gains = std::array<double, 3>{1, 1, 1};
+    return out;
+  }
   Frame f = Frame::allocate(format, width, height);
   auto px = [&](int x, int y) { return rgb + (size_t(y) * width + x) * 3; };
   for (int y = 0; y < height; ++y) {

@@ -19,13 +19,13 @@ void to_grey(const Frame& frame, std::vector<uint8_t>& out);
 void to_grey(const Frame& frame, const PixelRect& rect, std::vector<uint8_t>& out);
 // Writes width*height*3 bytes of RGB (no stride) into out. BT.601 limited range for YUV formats;
 // GREY is full range (R = G = B = the grey value). Bayer formats are developed by
-// core/image/bayer.h with its defaults (no black level, unit gains, OpenCV's edge-aware
-// demosaicing) and sRGB-encoded; a caller that knows the sensor's black level or white balance
-// calls bayer_to_rgb24 itself.
+// core/image/bayer.h as their meta.raw says (core/raw_colour.h: black level, gains, colour matrix;
+// grey-world gains when it has none) and sRGB-encoded.
 void to_rgb24(const Frame& frame, std::vector<uint8_t>& out);
-// Converts a packed RGB24 image (no stride) to the given format, into a new Frame (metadata left default).
-// A Bayer format gets each pixel's CFA channel, sRGB-decoded to linear at the format's depth
-// (black level 0): to_rgb24 gives a flat region back exactly.
+// Converts a packed RGB24 image (no stride) to the given format, into a new Frame (metadata left
+// default but for a Bayer format's meta.raw). A Bayer format gets each pixel's CFA channel,
+// sRGB-decoded to linear at the format's depth, with black level 0 and unit gains in meta.raw:
+// to_rgb24 gives a flat region back exactly.
 Frame from_rgb24(const uint8_t* rgb, int width, int height, PixelFormat format);
 // Planar 4:2:0 (I420, as Y4M wants it) from packed RGB24 whose rows are rgb_width pixels long:
 // the top-left width x height pixels (both even) become a Y plane, a U plane and a V plane.

@@ -51,7 +51,7 @@ constexpr float kRawClippedFrom = 0.98f;
 bool decode_bayer_patch(const Frame& frame, const ImageRect& r, LinearPatch& out) {
   thread_local std::vector<float> linear;
   try {
-    develop_bayer(frame, BayerDevelopment{}, linear);
+    develop_bayer(frame, bayer_development(frame.meta.raw), linear);
   } catch (const std::exception&) {
     return false;  // a frame the format cannot hold: unusable, like a short buffer below
   }

@@ -62,6 +62,14 @@ inline Frame random_frame(PixelFormat format, int width, int height, size_t byte
   // Every other frame says what the camera measured (libcamera's Lux and ColourTemperature).
   f.meta.lux = index % 2 ? 0.0 : 312.5 + double(index);
   f.meta.colour_temperature_k = index % 2 ? 0.0 : 4650.0;
+  // Every third frame says how its raw values develop, in values no float round trip could keep
+  // by accident (core/raw_colour.h).
+  if (index % 3 == 0) {
+    f.meta.raw.black_level = std::array<double, 4>{64.25, 63.5, 65, 64.125 + double(index)};
+    f.meta.raw.white_level = 1000.5;
+    f.meta.raw.gains = std::array<double, 3>{1.0 / 3.0, 1, 2.7182818284590451};
+    f.meta.raw.colour_matrix = std::array<double, 9>{1.5, -0.25, -0.25, -0.1, 1.2, -0.1, 1e-17, -0.5, 1.5};
+  }
   return f;
 }
 

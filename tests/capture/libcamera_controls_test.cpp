@@ -42,6 +42,19 @@ TEST(LibcameraControls, RequestMetadataMapsExactly) {
   EXPECT_EQ(r.meta.colour_temperature_k, 4500.0);
 }
 
+TEST(LibcameraControls, RawDevelopmentMetadataIsRead) {
+  libcamera::ControlList md(c::controls);
+  md.set(c::SensorBlackLevels, libcamera::Span<const int32_t, 4>(std::array<int32_t, 4>{4096, 4100, 4104, 4108}));
+  md.set(c::ColourGains, libcamera::Span<const float, 2>(std::array<float, 2>{1.5f, 2.25f}));
+  const std::array<float, 9> ccm{1.5f, -0.25f, -0.25f, -0.125f, 1.25f, -0.125f, 0.0f, -0.5f, 1.5f};
+  md.set(c::ColourCorrectionMatrix, libcamera::Span<const float, 9>(ccm));
+  const auto v = read_request_values(md);
+  ASSERT_TRUE(v.sensor_black_levels_16bit && v.colour_gains_rb && v.colour_correction_matrix);
+  EXPECT_EQ(*v.sensor_black_levels_16bit, (std::array<double, 4>{4096, 4100, 4104, 4108}));
+  EXPECT_EQ(*v.colour_gains_rb, (std::array<double, 2>{1.5, 2.25}));
+  for (size_t i = 0; i < 9; ++i) EXPECT_EQ((*v.colour_correction_matrix)[i], double(ccm[i])) << i;
+}
+
 TEST(LibcameraControls, AbsentControlsStayAbsent) {
   libcamera::ControlList md(c::controls);
   md.set(c::SensorTimestamp, int64_t{77});

@@ -3,6 +3,8 @@
 // All quantities are integers or exactly representable, so the comparisons are exact.
 #include <gtest/gtest.h>
 
+#include <array>
+
 #include "capture/libcamera/libcamera_metadata.h"
 
 namespace arpipe {
@@ -38,6 +40,27 @@ TEST(LibcameraMetadata, EveryValuePresentMapsExactly) {
   EXPECT_EQ(m.digital_gain, 1.25);
   EXPECT_EQ(m.lux, 412.5);
   EXPECT_EQ(m.colour_temperature_k, 5600);
+}
+
+// A raw stream's development (core/raw_colour.h): SensorBlackLevels is at a 16-bit scale (4096
+// is 256 at 12 bits, 64 at 10), ColourGains are red and blue (green 1), the matrix passes as is.
+// A processed stream's frames carry none of it: its pixels are developed already.
+TEST(LibcameraMetadata, RawStreamsCarryTheirBlackLevelsGainsAndMatrix) {
+  LibcameraRequestValues v = full_values();
+  v.sensor_black_levels_16bit = std::array<double, 4>{4096, 4096, 4160, 4032};
+  v.colour_gains_rb = std::array<double, 2>{1.75, 2.5};
+  v.colour_correction_matrix = std::array<double, 9>{1.5, -0.25, -0.25, -0.125, 1.25, -0.125, 0, -0.5, 1.5};
+  LibcameraTiming timing = libcamera_timing(0, 0, 0, 0, 30);
+  timing.raw_bit_depth = 10;
+  const FrameMetadata m = map_libcamera_metadata(v, 1, 0, timing).meta;
+  ASSERT_TRUE(m.raw.black_level && m.raw.gains && m.raw.colour_matrix);
+  EXPECT_EQ(*m.raw.black_level, (std::array<double, 4>{64, 64, 65, 63}));
+  EXPECT_EQ(*m.raw.gains, (std::array<double, 3>{1.75, 1, 2.5}));
+  EXPECT_EQ(*m.raw.colour_matrix, *v.colour_correction_matrix);
+  timing.raw_bit_depth = 12;
+  EXPECT_EQ(*map_libcamera_metadata(v, 1, 0, timing).meta.raw.black_level, (std::array<double, 4>{256, 256, 260, 252}));
+  timing.raw_bit_depth = 0;
+  EXPECT_EQ(map_libcamera_metadata(v, 1, 0, timing).meta.raw, RawColour{});
 }
 
 // source.timestamp_meaning settles what a board's SensorTimestamp means without a rebuild

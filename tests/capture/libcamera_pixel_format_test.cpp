@@ -35,9 +35,31 @@ TEST(LibcameraPixelFormat, YuvAndGreyRoundTrip) {
 
 TEST(LibcameraPixelFormat, UnknownFormatsAreNotGuessed) {
   EXPECT_FALSE(pixel_format_from_libcamera(libcamera::formats::YUV420));
-  EXPECT_FALSE(pixel_format_from_libcamera(libcamera::formats::SBGGR10));
+  // IPU3's Bayer packing (25 pixels in 32 bytes) is not MIPI's: not taken.
+  EXPECT_FALSE(pixel_format_from_libcamera(libcamera::formats::SRGGB10_IPU3));
   EXPECT_FALSE(pixel_format_from_libcamera(libcamera::formats::XRGB8888));
   EXPECT_FALSE(pixel_format_from_libcamera(libcamera::PixelFormat()));
+}
+
+// Raw Bayer: DRM's unpacked Bayer fourccs ('RG10' = SRGGB10, 16 bits a pixel, little-endian) are
+// V4L2's; its MIPI-packed ones are the same fourcc with the CSI2 packed modifier
+// (fourcc_mod_code(MIPI, 1)), which V4L2 names with its own fourcc ('pRAA' = SRGGB10P).
+TEST(LibcameraPixelFormat, RawBayerFormatsAreV4l2sOwnLayouts) {
+  EXPECT_EQ(libcamera_pixel_format(PixelFormat::SRGGB10).fourcc(), fourcc('R', 'G', '1', '0'));
+  EXPECT_EQ(libcamera_pixel_format(PixelFormat::SRGGB10).modifier(), 0u);
+  EXPECT_EQ(libcamera_pixel_format(PixelFormat::SBGGR8).fourcc(), fourcc('B', 'A', '8', '1'));
+  EXPECT_EQ(libcamera_pixel_format(PixelFormat::SGBRG16).fourcc(), fourcc('G', 'B', '1', '6'));
+  const auto packed = libcamera_pixel_format(PixelFormat::SRGGB10P);
+  EXPECT_EQ(packed.fourcc(), fourcc('R', 'G', '1', '0'));
+  EXPECT_EQ(packed.modifier(), (uint64_t{11} << 56) | 1u);  // DRM_FORMAT_MOD_VENDOR_MIPI = 11
+  EXPECT_EQ(pixel_format_from_libcamera(libcamera::formats::SGRBG12_CSI2P), PixelFormat::SGRBG12P);
+  for (PixelFormat f : {PixelFormat::SRGGB8, PixelFormat::SGRBG10, PixelFormat::SBGGR12, PixelFormat::SGBRG16,
+                        PixelFormat::SBGGR10P, PixelFormat::SGBRG12P})
+    EXPECT_EQ(pixel_format_from_libcamera(libcamera_pixel_format(f)), f) << pixel_format_name(f);
+  // Auto takes a processed format before a raw one.
+  namespace fm = libcamera::formats;
+  EXPECT_EQ(preferred_libcamera_format({fm::SRGGB10_CSI2P, fm::NV12}), PixelFormat::NV12);
+  EXPECT_EQ(preferred_libcamera_format({fm::SRGGB10_CSI2P}), PixelFormat::SRGGB10P);
 }
 
 TEST(LibcameraPixelFormat, AutoPrefersRgb24ThenYuyvThenNv12ThenGrey) {

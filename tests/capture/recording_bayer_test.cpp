@@ -4,6 +4,9 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <tuple>
+#include <vector>
+
 #include "capture/recording/recording_reader.h"
 #include "capture_test_support.h"
 
@@ -57,6 +60,41 @@ TEST(RecordingBayer, WrongSizesAndStridesAreRefusedByName) {
   // A format name that does not exist.
   message = error_with("\"SRGGB10P\"", "\"SRGGB11P\"");
   EXPECT_EQ(message.rfind(json.string(), 0), 0u) << message;
+  fs::remove_all(dir);
+}
+
+// A frame's development values (core/raw_colour.h) are read as hostile as the rest: the wrong
+// count, a gain that is not positive, a negative black level or a white level past 16 bits are
+// refused naming the file, the line and the field. Whether they fit the frame's bit depth is the
+// source's check (capture/raw_colour_source.h), made per frame.
+TEST(RecordingBayer, BadDevelopmentValuesAreRefusedByName) {
+  const fs::path dir = scratch_dir("bayer-raw-values");
+  write_recording(dir, PixelFormat::SRGGB10P, kWidth, kHeight, 2);
+  const fs::path lines = dir / "frames.jsonl";
+  const std::string original = read_file(lines);
+  ASSERT_NE(original.find("\"colour_gains\""), std::string::npos) << "frame 0 carries its development values";
+  auto error_with = [&](const std::string& field, const std::string& value) {
+    // The first frame's value of `field` replaced: an array up to its ']', a number up to ',' or '}'.
+    const size_t at = original.find("\"" + field + "\":");
+    EXPECT_NE(at, std::string::npos) << field;
+    const size_t value_at = at + field.size() + 3;
+    const size_t value_end = original[value_at] == '[' ? original.find(']', value_at) + 1
+                                                       : original.find_first_of(",}", value_at);
+    std::string text = original;
+    text.replace(value_at, value_end - value_at, value);
+    write_file(lines, text);
+    return error_message([&] { RecordingReader reader(dir); });
+  };
+  for (const auto& [field, value, says] :
+       std::vector<std::tuple<std::string, std::string, std::string>>{{"colour_gains", "[1,0,1]", "colour_gains[1]"},
+                                                                      {"colour_gains", "[1,1]", "colour_gains"},
+                                                                      {"black_level", "[64,64,-1,64]", "black_level[2]"},
+                                                                      {"colour_matrix", "[1,0,0,0,1,0,0,0]", "colour_matrix"},
+                                                                      {"white_level", "70000", "white_level"}}) {
+    const std::string message = error_with(field, value);
+    EXPECT_EQ(message.rfind(lines.string(), 0), 0u) << message;
+    EXPECT_NE(message.find(says), std::string::npos) << field << " = " << value << ": " << message;
+  }
   fs::remove_all(dir);
 }
 

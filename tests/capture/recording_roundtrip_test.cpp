@@ -28,6 +28,7 @@ void expect_same_metadata(const FrameMetadata& a, const FrameMetadata& b) {
   EXPECT_EQ(a.timestamp_offset_ns, b.timestamp_offset_ns);
   EXPECT_EQ(a.lux, b.lux);
   EXPECT_EQ(a.colour_temperature_k, b.colour_temperature_k);
+  EXPECT_EQ(a.raw, b.raw);
 }
 
 // Poses pass through a rotation vector printed exactly, then Rodrigues: a few ulps of drift.

@@ -164,7 +164,8 @@ fs::path bayer_copy_of_default_capture(const fs::path& dir, size_t frames) {
 }  // namespace
 
 // Issue 24: a raw Bayer camera. The stand-in serves the mosaic as it is, the V4L2 source passes it
-// on raw, the tracker and the light stage develop it (core/image/bayer.h), and the daemon tracks
+// on raw, the source measures its grey-world gains (capture/raw_colour_source.h), the tracker and
+// the light stage develop it (core/image/bayer.h), and the daemon tracks
 // the tag to the bar the YUYV capture meets (the anchor within 1 px of the true pose) and
 // composites the cube on every frame that sees the whole tag.
 TEST_F(LiveV4L2, ARawBayerCameraIsTrackedAndComposited) {
@@ -189,6 +190,8 @@ TEST_F(LiveV4L2, ARawBayerCameraIsTrackedAndComposited) {
       dir_ / "logs", &err, env);
   ASSERT_EQ(status, 0) << err;
   EXPECT_NE(err.find("streaming SGRBG10P 640x480"), std::string::npos) << err;
+  // A V4L2 sensor says nothing of its colours: the frames develop with grey-world gains.
+  EXPECT_NE(err.find("(grey world, per frame)"), std::string::npos) << err;
   const RecordingReader reader(kCapture);
   const CameraModel& model = reader.camera_model();
   std::ifstream results(dir_ / "results.jsonl");

@@ -247,6 +247,35 @@ TEST(Config, LiveSourceChoicesReadIntoTheirEnums) {
   EXPECT_EQ(libcamera.pipeline.log_level, log::Level::Warning);
 }
 
+// [source.raw] (core/config/raw_colour_config.h): empty lists keep the camera's values; counts,
+// ranges and the gains' need of white_balance = "fixed" are checked where they are written.
+TEST(Config, RawColourKeysReadBackAndBadOnesAreNamed) {
+  const Config defaults;
+  EXPECT_TRUE(defaults.source.raw.black_level.empty());
+  EXPECT_TRUE(defaults.source.raw.colour_matrix.empty());
+  EXPECT_EQ(defaults.source.raw.white_balance, WhiteBalanceMode::Auto);
+  const Config c = parse_config(
+      "[source.raw]\nblack_level = [64, 64.5, 65, 63]\nwhite_level = 1000\nwhite_balance = \"fixed\"\n"
+      "gains = [1.5, 1, 2.25]\ncolour_matrix = [1.5, -0.25, -0.25, -0.125, 1.25, -0.125, 0, -0.5, 1.5]\n",
+      "r.toml");
+  EXPECT_EQ(c.source.raw.black_level, (std::vector<double>{64, 64.5, 65, 63}));
+  EXPECT_EQ(c.source.raw.white_level, 1000);
+  EXPECT_EQ(c.source.raw.white_balance, WhiteBalanceMode::Fixed);
+  EXPECT_EQ(c.source.raw.gains, (Vec3{1.5, 1, 2.25}));
+  EXPECT_EQ(c.source.raw.colour_matrix, (std::vector<double>{1.5, -0.25, -0.25, -0.125, 1.25, -0.125, 0, -0.5, 1.5}));
+  EXPECT_EQ(parse_config("[source.raw]\nwhite_balance = \"grey-world\"\nblack_level = [16]\n", "r.toml").source.raw.black_level,
+            (std::vector<double>{16}));
+  expect_error("[source.raw]\nblack_level = [64, 64]\n",
+               {"test.toml:2:", "source.raw.black_level: expected [], 1 or 4 raw codes, found 2 numbers"});
+  expect_error("[source.raw]\nblack_level = [-1]\n", {"source.raw.black_level[0]", "found -1"});
+  expect_error("[source.raw]\ncolour_matrix = [1, 0, 0]\n", {"source.raw.colour_matrix: expected [] or 9 numbers, found 3 numbers"});
+  expect_error("[source.raw]\ngains = [2, 1, 2]\n", {"source.raw.gains", "white_balance = \"fixed\""});
+  expect_error("[source.raw]\nwhite_balance = \"fixed\"\ngains = [0, 1, 2]\n", {"source.raw.gains", "found 0"});
+  expect_error("[source.raw]\nwhite_level = 255\nblack_level = [255]\n",
+               {"source.raw.black_level: expected codes below white_level (255), found 255"});
+  expect_error("[source.raw]\nwhite_balance = \"daylight\"\n", {"source.raw.white_balance: expected one of \"auto\""});
+}
+
 TEST(Config, InlineArrayOfTablesIsTheSameAsArrayOfTables) {
   const Config a = parse_config("[track]\nbundle = [{id = 3, size_m = 0.2}, {id = 4}]\n", "a.toml");
   ASSERT_EQ(a.track.bundle.size(), 2u);
