@@ -234,8 +234,12 @@ class V4L2Stream final : public CameraStream {
                      : "";
     const std::string planes =
         device_.multi_planar() ? fmt::format(" of {} plane{}", memory_planes_, memory_planes_ > 1 ? "s" : "") : "";
-    return fmt::format("{} {}x{}{}{}, {} {}buffers{}", format_.camera_format, format_.width, format_.height, rate,
-                       decoded, buffers_->count(), device_.multi_planar() ? "multi-planar " : "", planes);
+    // Which path the pixels take: always out of the mapped buffer on the CPU (no dma-buf import,
+    // docs/ARCHITECTURE.md), into frame memory the pipeline hands back.
+    const char* path = mjpeg_ ? "decoded from the mapped buffer into recycled frames"
+                              : "one copy a frame from the mapped buffer into recycled frames";
+    return fmt::format("{} {}x{}{}{}, {} {}buffers{} ({})", format_.camera_format, format_.width, format_.height, rate,
+                       decoded, buffers_->count(), device_.multi_planar() ? "multi-planar " : "", planes, path);
   }
 
   template <typename F> void count(F&& update) {
