@@ -18,6 +18,7 @@
 #include "calib/calibration_run.h"
 #include "calib/calibration_solver.h"
 #include "calib/corners_vnl.h"
+#include "calib/optimization_inputs.h"
 #include "calib/residual_image.h"
 #include "core/log.h"
 
@@ -84,7 +85,8 @@ int calibrate(const CalibOptions& command) {
   write_text(beside(out, ".report.txt"), calib::report_text(report));
   write_text(beside(out, ".report.json"), calib::report_json(report));
   calib::write_residual_image(beside(out, ".residuals.png"), result);
-  result.model.save(out);
+  // With mrcal's optimization_inputs, so its uncertainty, residual and culling tools read the solve.
+  calib::save_model_with_optimization_inputs(result, out);
   std::fputs(calib::report_text(report).c_str(), stdout);
   log::info("wrote {} (and its report, residual picture and corners beside it)", out.string());
   return 0;
