@@ -54,6 +54,9 @@ struct Surface {
   Kind kind = Kind::Plane;
   bool mirror = false;
   Rgb albedo{0, 0, 0};  // diffuse albedo, or the mirror's reflectance
+  // Lambertian: the Blinn-Phong highlight's reflectance and exponent (0: none).
+  double specular = 0;
+  double shininess = 0;
   std::optional<PlaneTexture> texture;
   // Plane: its frame, for texture coordinates.
   Vec3 centre{0, 0, 0}, x_axis{1, 0, 0}, y_axis{0, 1, 0};
@@ -113,6 +116,13 @@ struct SceneShader::Impl {
     surface.mirror = material.kind == SimMaterial::Kind::Mirror;
     surface.albedo = material.albedo;
     surface.is_virtual = object.is_virtual;
+    check_object(material.specular >= 0 && material.specular <= 1, object,
+                 fmt::format("specular must be in [0, 1], got {}", material.specular));
+    check_object(material.specular == 0 || !surface.mirror, object, "a mirror has no glossy highlight (specular)");
+    check_object(material.specular == 0 || (material.shininess >= 1 && std::isfinite(material.shininess)), object,
+                 fmt::format("shininess must be a finite number >= 1, got {}", material.shininess));
+    surface.specular = material.specular;
+    surface.shininess = material.shininess;
     check_object(material.texture.kind == SimTexture::Kind::None || object.shape == SimObject::Shape::Plane, object,
                  "textures cover planes only");
     check_object(material.texture.kind == SimTexture::Kind::None || !surface.mirror, object,
@@ -258,13 +268,28 @@ struct SceneShader::Impl {
     return dot(n, facing) >= 0 ? n : -1.0 * n;
   }
 
-  // A Lambertian point p with geometric normal n facing the viewer, reached after travelling t:
-  // albedo / pi * sum of the lights' irradiance (each with its own shadow ray), plus the sky's
-  // light from one cosine-weighted direction (the sky alone: directional discs are lights above).
-  Rgb shade_diffuse(const Surface& s, const ShapeHit& hit, const Vec3& p, const Vec3& n, SampleRng& rng) const {
+  // A Lambertian point p with geometric normal n facing the viewer, reached after travelling t
+  // along d: albedo / pi * sum of the lights' irradiance (each with its own shadow ray), plus the
+  // sky's light from one cosine-weighted direction (the sky alone: directional discs are lights
+  // above). A glossy surface (specular > 0) adds the normalised Blinn-Phong lobe
+  // specular * (m + 8) / (8 pi) * (ns.h)^m for each light's sample direction w, h the unit half
+  // vector of w and the view direction -d, weighted by the same irradiance: the highlights of the
+  // lights, in their own colour. The sky gets no highlight.
+  Rgb shade_diffuse(const Surface& s, const ShapeHit& hit, const Vec3& p, const Vec3& n, const Vec3& d,
+                    SampleRng& rng) const {
     const Rgb albedo = diffuse_reflectance(s, hit, p);
     const Vec3 ns = shading_normal(s, hit, n);
     const Vec3 o = p + ray_offset(p, hit.t) * n;
+    const bool glossy = s.specular > 0;
+    const Vec3 view = -1.0 * d;
+    Rgb highlight{0, 0, 0};  // sum of (ns.h)^m times each light's irradiance
+    const auto add_highlight = [&](const Vec3& w, const Rgb& irradiance_from_w) {
+      const Vec3 h = w + view;
+      const double length = norm(h);
+      if (!(length > 0)) return;
+      const double c = dot(ns, h) / length;
+      if (c > 0) highlight += std::pow(c, s.shininess) * irradiance_from_w;
+    };
     Rgb irradiance{0, 0, 0};
     for (const DirectionalLight& light : directional) {
       Vec3 w = light.to_light;
@@ -273,14 +298,20 @@ struct SceneShader::Impl {
         w = sample_cone(light.frame, light.one_minus_cos, u1, u2);
       }
       const double c = dot(ns, w);
-      if (c > 0 && dot(n, w) > 0 && !scene.occluded(o, w)) irradiance += c * light.sample_weight;
+      if (c > 0 && dot(n, w) > 0 && !scene.occluded(o, w)) {
+        irradiance += c * light.sample_weight;
+        if (glossy) add_highlight(w, c * light.sample_weight);
+      }
     }
     for (const PointLight& light : points) {
       const Vec3 to_light = light.position - p;
       const double d2 = dot(to_light, to_light);
       const Vec3 w = (1.0 / std::sqrt(d2)) * to_light;
       const double c = dot(ns, w);
-      if (c > 0 && dot(n, w) > 0 && !scene.occluded(o, w, 0, std::sqrt(d2))) irradiance += (c / d2) * light.intensity;
+      if (c > 0 && dot(n, w) > 0 && !scene.occluded(o, w, 0, std::sqrt(d2))) {
+        irradiance += (c / d2) * light.intensity;
+        if (glossy) add_highlight(w, (c / d2) * light.intensity);
+      }
     }
     for (const SphereLight& light : spheres) {
       // One direction uniform in the cone the sphere subtends: E ~ L * solid angle * cos.
@@ -291,10 +322,13 @@ struct SceneShader::Impl {
       const double c = dot(ns, w);
       if (!(c > 0 && dot(n, w) > 0)) continue;
       const double t_light = intersect_sphere(o, w, light.sphere, 0, kInfinity);
-      if (!scene.occluded(o, w, 0, t_light, light.shape))
+      if (!scene.occluded(o, w, 0, t_light, light.shape)) {
         irradiance += (c * cone_solid_angle(cone.one_minus_cos)) * light.radiance;
+        if (glossy) add_highlight(w, (c * cone_solid_angle(cone.one_minus_cos)) * light.radiance);
+      }
     }
     Rgb out = (1.0 / kPi) * (albedo * irradiance);
+    if (glossy) out += (s.specular * (s.shininess + 8) / (8 * kPi)) * highlight;
     if (!environment.is_black()) {
       // Cosine-weighted: the pdf cos/pi cancels the BRDF's 1/pi and the cosine.
       const double u1 = rng.uniform(), u2 = rng.uniform();
@@ -313,7 +347,7 @@ struct SceneShader::Impl {
     if (s.kind == Surface::Kind::Light) return s.emitted;
     const Vec3 p = origin + hit.t * d;
     const Vec3 n = dot(hit.normal, d) < 0 ? hit.normal : -1.0 * hit.normal;
-    if (!s.mirror) return shade_diffuse(s, hit, p, n, rng);
+    if (!s.mirror) return shade_diffuse(s, hit, p, n, d, rng);
 
     // One mirror bounce. A mirror seen in the mirror shows the sky (and light discs) along its own
     // reflection, cast no further: enough for light probes, which never face each other closely.
@@ -326,7 +360,7 @@ struct SceneShader::Impl {
     const Vec3 p2 = o2 + hit2.t * r;
     const Vec3 n2 = dot(hit2.normal, r) < 0 ? hit2.normal : -1.0 * hit2.normal;
     if (s2.mirror) return (s.albedo * s2.albedo) * sky(r - (2 * dot(r, n2)) * n2);
-    return s.albedo * shade_diffuse(s2, hit2, p2, n2, rng);
+    return s.albedo * shade_diffuse(s2, hit2, p2, n2, r, rng);
   }
 };
 

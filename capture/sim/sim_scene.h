@@ -51,6 +51,12 @@ struct SimMaterial {
   Kind kind = Kind::Lambertian;
   Rgb albedo{0.5, 0.5, 0.5};  // Lambertian: diffuse reflectance; Mirror: specular reflectance
   SimTexture texture;         // Lambertian only; when set it replaces albedo (Image: multiplies)
+  // Lambertian only: a glossy (Blinn-Phong) highlight of the lights on top of the diffuse term,
+  // BRDF specular * (shininess + 8) / (8 pi) * (n.h)^shininess, h the half vector of the light
+  // and view directions; it takes the light's colour (a dielectric such as paper or plastic).
+  // 0: none (the pure Lambertian surface, bit for bit).
+  double specular = 0;
+  double shininess = 50;
 };
 inline constexpr ChoiceName<SimMaterial::Kind> kSimMaterialKindNames[] = {{"lambertian", SimMaterial::Kind::Lambertian},
                                                                           {"mirror", SimMaterial::Kind::Mirror}};
@@ -179,6 +185,18 @@ struct SimStereo {
   OdsRig rig;
 };
 
+// The lens's own effects on the image, applied to the linear radiance image before the sensor
+// (capture/sim/lens_optics.h): first defocus, then vignetting. The defaults change nothing.
+struct SimOptics {
+  // Defocus: a uniform disc point-spread function of this diameter (the circle of confusion) in
+  // pixels; 0: in focus.
+  double defocus_px = 0;
+  // Vignetting: the lens's relative illumination (1 - v) + v cos^4(theta), theta the angle of the
+  // pixel's ray from the optical axis (cos clamped at 0); 0: none, 1: the full cos^4 law.
+  double vignetting = 0;
+  bool active() const { return defocus_px > 0 || vignetting > 0; }
+};
+
 struct SimCamera {
   CameraModel model = CameraModel::pinhole(500, 500, 319.5, 239.5, 640, 480);
   PixelFormat pixel_format = PixelFormat::YUYV;
@@ -196,6 +214,10 @@ struct SimCamera {
   SimAutoExposure auto_exposure;
   SimSensor sensor;
   SimStereo stereo;
+  SimOptics optics;
+  // Each written frame is encoded to JPEG at this quality (1..100) and decoded back into its
+  // pixels (capture/sim/jpeg_round_trip.h); 0: off. Not for Bayer formats.
+  int jpeg_quality = 0;
 
   // The frame's size: one eye's (the model's), or the stereo pair's.
   int frame_width() const { return stereo.enabled && !stereo.top_bottom ? 2 * model.width() : model.width(); }

@@ -54,6 +54,8 @@ constexpr double kMaxAbsMs = 1e12;  // 31 years
 const NumberRange kPositive = NumberRange::above(0);
 const NumberRange kNonNegative = NumberRange::at_least(0);
 const NumberRange kUnitInterval = NumberRange::closed(0, 1);
+// The largest circle of confusion: a 33 x 33 kernel, a few seconds a 640 x 480 frame.
+constexpr double kMaxDefocusPx = 32;
 
 std::string show(const Vec3& v) { return fmt::format("[{}, {}, {}]", v[0], v[1], v[2]); }
 
@@ -297,6 +299,18 @@ SimCamera read_camera(const TomlSection& s) {
       out.black_level = sensor->integer_as<int>("black_level", out.black_level, IntRange{0, (1 << bits) - 2});
     }
   }
+
+  // A camera that sends JPEG: any of the YUV, RGB and grey formats, not a raw mosaic.
+  camera.jpeg_quality = s.integer_as<int>("jpeg_quality", camera.jpeg_quality, IntRange{0, 100});
+  if (camera.jpeg_quality > 0 && is_bayer(camera.pixel_format))
+    s.fail_with("jpeg_quality", fmt::format("expected a JPEG quality only for RGB24, YUYV, GREY and NV12 frames "
+                                            "(0 = off), found {} with camera.pixel_format the raw Bayer format {}",
+                                            camera.jpeg_quality, pixel_format_name(camera.pixel_format)));
+  if (const auto optics = s.section("optics")) {
+    SimOptics& out = camera.optics;
+    out.defocus_px = optics->number("defocus_px", out.defocus_px, NumberRange::closed(0, kMaxDefocusPx).in("px"));
+    out.vignetting = optics->number("vignetting", out.vignetting, kUnitInterval);
+  }
   return camera;
 }
 
@@ -482,6 +496,13 @@ SimObject read_object(const TomlSection& s, size_t index) {
 
   out.material.kind = s.choice("material", out.material.kind, kSimMaterialKindNames);
   out.material.albedo = s.vec3("albedo", out.material.albedo, kUnitInterval);
+  if (out.material.kind == SimMaterial::Kind::Mirror) {
+    forbid(s, "specular", "a mirror reflects perfectly; specular is a Lambertian surface's glossy highlight");
+    forbid(s, "shininess", "a mirror reflects perfectly; shininess is a Lambertian surface's glossy highlight");
+  }
+  out.material.specular = s.number("specular", out.material.specular, kUnitInterval);
+  if (!s.has("specular")) forbid(s, "shininess", "it shapes the highlight that specular turns on; give specular too");
+  out.material.shininess = s.number("shininess", out.material.shininess, NumberRange::closed(1, 100000));
 
   if (out.shape == SimObject::Shape::Plane) {
     only({"radius_m"}, "sphere");

@@ -17,6 +17,8 @@
 #include "capture/sim/exposure_control.h"
 #include "capture/sim/frame_renderer.h"
 #include "capture/sim/ground_truth_coverage.h"
+#include "capture/sim/jpeg_round_trip.h"
+#include "capture/sim/lens_optics.h"
 #include "capture/sim/raw_exposure.h"
 #include "capture/sim/scene_shader.h"
 #include "capture/sim/sensor_model.h"
@@ -130,8 +132,16 @@ void write_linear_image(const fs::path& path, const RadianceImage& radiance, con
   if (!written) throw RecordingError(fmt::format("{}: cannot write the linear image", path.string()));
 }
 
-Frame to_frame(const std::vector<uint8_t>& rgb, int width, int height, PixelFormat format, const FrameMetadata& meta) {
+// The sensor's 8-bit RGB in the recording's format. With jpeg_quality > 0 the camera sends JPEG:
+// RGB (4:2:0) through a JPEG round trip before the format's conversion, or for GREY the grey
+// plane through a one-component JPEG.
+Frame to_frame(std::vector<uint8_t> rgb, int width, int height, PixelFormat format, const FrameMetadata& meta,
+               int jpeg_quality = 0) {
+  if (jpeg_quality > 0 && format != PixelFormat::GREY)
+    jpeg_round_trip(rgb.data(), width, height, size_t(width) * 3, 3, jpeg_quality);
   Frame frame = from_rgb24(rgb.data(), width, height, format);
+  if (jpeg_quality > 0 && format == PixelFormat::GREY)
+    jpeg_round_trip(frame.data.data(), width, height, frame.bytes_per_line, 1, jpeg_quality);
   frame.meta = meta;
   return frame;
 }
@@ -149,12 +159,14 @@ void place_eye(const std::vector<float>& eye, int width, int height, int channel
 }
 
 // One frame's radiance (and coverage) as the camera sees it: a mono image, or the stereo pair's
-// two eyes in their places.
+// two eyes in their places; each eye through the lens's defocus and vignetting when it has them
+// (the coverage is the geometric one, left alone).
 void render_frame(const FrameRenderer& renderer, const SimCamera& camera, const SceneShader& shader,
                   const ShutterPoseTable& poses, const FrameMetadata& meta, double start_s, uint64_t index,
-                  RadianceImage& out, std::vector<float>* coverage) {
+                  const LensOptics& optics, RadianceImage& out, std::vector<float>* coverage) {
   if (!camera.stereo.enabled) {
     renderer.render(shader, poses, meta, start_s, index, out, coverage);
+    if (optics.active()) optics.apply(out);
     return;
   }
   RadianceImage eye;
@@ -162,6 +174,7 @@ void render_frame(const FrameRenderer& renderer, const SimCamera& camera, const 
   for (int which = 0; which < 2; ++which) {
     renderer.render(shader, poses, meta, start_s, index, eye, coverage ? &eye_coverage : nullptr,
                     which == 0 ? Eye::Left : Eye::Right, camera.stereo.rig);
+    if (optics.active()) optics.apply(eye);
     place_eye(eye.rgb, eye.width, eye.height, 3, camera.stereo.top_bottom, which, out.rgb);
     if (coverage) place_eye(eye_coverage, eye.width, eye.height, 1, camera.stereo.top_bottom, which, *coverage);
   }
@@ -193,6 +206,11 @@ SimulateSummary simulate(const SimScene& scene, const SimulateOptions& options) 
   // the left eye's half, which starts at the frame's top left corner.
   const CameraModel recorded_model =
       camera.stereo.enabled ? CameraModel(camera.model.lensmodel(), camera.model.intrinsics(), width, height) : camera.model;
+  if (camera.jpeg_quality > 0 && is_bayer(camera.pixel_format))
+    throw std::invalid_argument(fmt::format("simulate: camera.jpeg_quality applies to RGB24, YUYV, GREY and NV12 frames, "
+                                            "not to the raw Bayer format {}",
+                                            pixel_format_name(camera.pixel_format)));
+  const LensOptics optics(camera.optics, rays, camera.model.width(), camera.model.height());
   const FrameRenderer renderer(rays, camera.model.width(), camera.model.height(), scene.render.samples_per_pixel, seed,
                                options.threads);
   const SceneShader camera_world(scene, false);
@@ -234,7 +252,7 @@ SimulateSummary simulate(const SimScene& scene, const SimulateOptions& options) 
     const double start_s = trajectory_time_s(camera, meta.exposure_start_ns);
 
     const ShutterPoseTable poses(trajectory, start_s, start_s + (meta.exposure_ns + meta.readout_ns) * 1e-9);
-    render_frame(renderer, camera, camera_world, poses, meta, start_s, index, radiance, nullptr);
+    render_frame(renderer, camera, camera_world, poses, meta, start_s, index, optics, radiance, nullptr);
     GroundTruthFrame truth = ground_truth(scene, trajectory, meta, lights);
     if (scene.render.write_linear) {
       truth.linear_image = fmt::format("linear_{:06d}.pfm", k);
@@ -243,7 +261,8 @@ SimulateSummary simulate(const SimScene& scene, const SimulateOptions& options) 
     // A raw camera's frame is the mosaic (raw_exposure.h); every other format encodes the RGB.
     Frame frame = is_bayer(camera.pixel_format)
                       ? expose_bayer(radiance, sensor, exposure, seed, index, camera.pixel_format, camera.sensor.black_level)
-                      : to_frame(expose(radiance, sensor, exposure, seed, index), width, height, camera.pixel_format, meta);
+                      : to_frame(expose(radiance, sensor, exposure, seed, index), width, height, camera.pixel_format, meta,
+                               camera.jpeg_quality);
     frame.meta = meta;
     // The simulated sensor's raw values are neutral: what its black level is, and unit gains.
     if (is_bayer(camera.pixel_format)) {
@@ -252,9 +271,11 @@ SimulateSummary simulate(const SimScene& scene, const SimulateOptions& options) 
     }
     writer.append(frame, truth);
     if (composite_world) {
-      render_frame(renderer, camera, *composite_world, poses, meta, start_s, index, composite_radiance, &coverage);
+      render_frame(renderer, camera, *composite_world, poses, meta, start_s, index, optics, composite_radiance,
+                   &coverage);
       composite_writer->append(
-          to_frame(expose(composite_radiance, sensor, exposure, seed, index), width, height, PixelFormat::RGB24, meta),
+          to_frame(expose(composite_radiance, sensor, exposure, seed, index), width, height, PixelFormat::RGB24, meta,
+                   camera.jpeg_quality),
           truth);
       coverage_writer->append(coverage_frame(coverage, width, height, meta), truth);
     }
