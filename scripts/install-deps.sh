@@ -33,6 +33,8 @@ packages=(
   libgtest-dev libgmock-dev librapidcheck-dev
   # mrcal's own tools: tests check our camera model against them
   mrcal python3-mrcal
+  # their plots (mrcal-show-*), written to files without a display
+  gnuplot-nox
   # the V4L2 stand-in's tests: v4l2-ctl and v4l2-compliance against it
   v4l-utils
   # checking the Y4M output plays
