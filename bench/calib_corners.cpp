@@ -1,6 +1,7 @@
-// Benchmark: chessboard corner accuracy against the simulator's truth, for each corner refinement
-// (the finder's own corners, cornerSubPix, cornerSubPix + the X-junction model fit), with the time
-// per image. The capture must be the calib-board scene or share its board layout (9 x 13 inner
+// Benchmark: chessboard detection and corner accuracy against the simulator's truth, for each
+// corner refinement (the finder's own corners, cornerSubPix, cornerSubPix + the X-junction model
+// fit) and each chessboard finder alone, with the time per image; and the views that OpenCV's
+// finders with their default flags find and arpipe's cascade loses (issue 25's bar: none). The capture must be the calib-board scene or share its board layout (9 x 13 inner
 // corners of 20 mm at x = -0.12 + 0.02 i, y = 0.08 - 0.02 j in the world).
 // `arpipe bench calib-corners [--recording DIR] [--board FILE] [--dump FILE]` prints a markdown
 // table for docs/BENCHMARKS.md. Defaults: build/calib-capture, configs/boards/chessboard-10x14-20mm.toml.
@@ -11,6 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <opencv2/calib3d.hpp>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -70,11 +72,19 @@ int run_calib_corners_benchmark(const CornersOptions& options) {
     if (!dump_file.empty() && !dump) throw std::runtime_error(dump_file + ": cannot write");
     if (dump) fmt::print(dump, "# refinement frame point x_true y_true x y\n");
     fmt::print("Corners against the truth on {} ({} frames, board {}):\n\n", recording, reader.frame_count(), board_file);
-    fmt::print("| refinement | boards found | RMS per coordinate | mean error x, y | largest error | ms per image |\n");
-    fmt::print("|---|---|---|---|---|---|\n");
-    for (const CornerRefinement refinement :
-         {CornerRefinement::none, CornerRefinement::corner_subpix, CornerRefinement::model_fit}) {
-      const BoardDetector detector(board, refinement);
+    fmt::print("| finder | refinement | boards found | RMS per coordinate | mean error x, y | largest error | ms per image |\n");
+    fmt::print("|---|---|---|---|---|---|---|\n");
+    // The cascade with each refinement, then each finder alone with the full refinement.
+    struct Row {
+      std::vector<ChessboardFinder> finders;  // empty: the cascade
+      CornerRefinement refinement;
+    };
+    std::vector<Row> rows{{{}, CornerRefinement::none}, {{}, CornerRefinement::corner_subpix}, {{}, CornerRefinement::model_fit}};
+    for (ChessboardFinder finder : chessboard_finders(board)) rows.push_back({{finder}, CornerRefinement::model_fit});
+    std::vector<bool> cascade_found(reader.frame_count(), false);
+    for (const auto& [finders, refinement] : rows) {
+      const BoardDetector detector(board, refinement, finders);
+      const std::string finder_name = finders.empty() ? "the cascade" : chessboard_finder_name(finders.front());
       Errors e;
       for (size_t f = 0; f < reader.frame_count(); ++f) {
         const GreyImage image = images->load(f);
@@ -83,6 +93,7 @@ int run_calib_corners_benchmark(const CornersOptions& options) {
         e.ms += milliseconds_since(start);
         if (!observation) continue;
         ++e.frames_found;
+        if (finders.empty()) cascade_found[f] = true;
         const SE3& T_cam_world = reader.ground_truth().at(f).T_cam_world_mid;
         for (size_t i = 0; i < world.size() && i < observation->pixels.size(); ++i) {
           const auto truth = reader.camera_model().project(T_cam_world * world[i]);
@@ -96,10 +107,30 @@ int run_calib_corners_benchmark(const CornersOptions& options) {
         }
       }
       const double n = std::max(e.points, 1);
-      fmt::print("| {} | {} of {} | {:.3f} px | {:+.3f}, {:+.3f} px | {:.2f} px | {:.1f} |\n", name(refinement),
-                 e.frames_found, reader.frame_count(), std::sqrt(e.sum2 / (2 * n)), e.sum_dx / n, e.sum_dy / n, e.max_px,
+      fmt::print("| {} | {} | {} of {} | {:.3f} px | {:+.3f}, {:+.3f} px | {:.2f} px | {:.1f} |\n", finder_name,
+                 name(refinement), e.frames_found, reader.frame_count(), std::sqrt(e.sum2 / (2 * n)), e.sum_dx / n, e.sum_dy / n, e.max_px,
                  e.ms / double(reader.frame_count()));
     }
+    // The independent references: OpenCV's finders with their default flags, as a user would call
+    // them. A view either finds that the cascade misses is a view lost.
+    int classic_found = 0, sb_found = 0, lost = 0;
+    std::string lost_names;
+    for (size_t f = 0; f < reader.frame_count(); ++f) {
+      const GreyImage image = images->load(f);
+      const cv::Mat grey(image.height, image.width, CV_8UC1, const_cast<uint8_t*>(image.pixels.data()));
+      std::vector<cv::Point2f> corners;
+      const bool classic = cv::findChessboardCorners(grey, cv::Size(board.cols, board.rows), corners);
+      const bool sb = cv::findChessboardCornersSB(grey, cv::Size(board.cols, board.rows), corners);
+      classic_found += classic;
+      sb_found += sb;
+      if ((classic || sb) && !cascade_found[f]) {
+        ++lost;
+        lost_names += " " + image.name;
+      }
+    }
+    fmt::print("\nOpenCV's findChessboardCorners with its default flags found {} of {}, findChessboardCornersSB {} of {};"
+               " views either found that the cascade lost: {}{}\n",
+               classic_found, reader.frame_count(), sb_found, reader.frame_count(), lost, lost_names);
     if (dump) std::fclose(dump);
   } catch (const std::exception& error) {
     fmt::print(stderr, "arpipe bench calib-corners: {}\n", error.what());

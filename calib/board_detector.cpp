@@ -86,6 +86,18 @@ constexpr double kAprilTagQuadDecimate = 1.0;
 // Pixel of a point that was not seen (weight -1): outside every image, never a plausible corner.
 constexpr Vec2 kUnseen{-1.0, -1.0};
 
+// Whether a view with points missing still counts: kMinSeenFraction of the board's points, over
+// at least two rows and two columns.
+bool enough_seen(const BoardObservation& view, const CalibrationBoard& board) {
+  std::set<int> rows, cols;
+  for (size_t i = 0; i < view.weights.size(); ++i)
+    if (view.weights[i] > 0) {
+      rows.insert(int(i) / board.cols);
+      cols.insert(int(i) % board.cols);
+    }
+  return view.seen_count() >= std::ceil(kMinSeenFraction * board.point_count()) && rows.size() >= 2 && cols.size() >= 2;
+}
+
 // A rows x cols grid of detected points in row-major order (index r*cols + c).
 struct Grid {
   int rows = 0;
@@ -160,8 +172,12 @@ Grid canonical_order(const Grid& grid) {
 // edges' directions from the neighbouring corners. A corner either step moves farther than
 // kMaxRefineShare of the distance to its nearest neighbour has slid towards another junction and
 // keeps its place from before that step.
-void refine_corners(const cv::Mat& image, CornerRefinement refinement, Grid& grid) {
-  if (refinement == CornerRefinement::none) return;
+BoardObservation::Refinements refine_corners(const cv::Mat& image, CornerRefinement refinement, Grid& grid) {
+  BoardObservation::Refinements counts;
+  if (refinement == CornerRefinement::none) {
+    counts.detector = int(grid.px.size());
+    return counts;
+  }
   const cv::TermCriteria stop(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50, 0.001);
   const Grid found = grid;
   for (int r = 0; r < grid.rows; ++r)
@@ -177,7 +193,12 @@ void refine_corners(const cv::Mat& image, CornerRefinement refinement, Grid& gri
       std::vector<cv::Point2f> corner{cv::Point2f(static_cast<float>(p[0]), static_cast<float>(p[1]))};
       cv::cornerSubPix(image, corner, cv::Size(window, window), cv::Size(-1, -1), stop);
       Vec2 refined{corner[0].x, corner[0].y};
-      if (std::hypot(refined[0] - p[0], refined[1] - p[1]) > kMaxRefineShare * spacing) refined = p;
+      int* placed_by = &counts.corner_subpix;
+      if (!std::isfinite(refined[0]) || !std::isfinite(refined[1]) ||
+          std::hypot(refined[0] - p[0], refined[1] - p[1]) > kMaxRefineShare * spacing) {
+        refined = p;
+        placed_by = &counts.detector;
+      }
       if (refinement == CornerRefinement::model_fit) {
         // The edges through the corner run towards the neighbours in its row and its column.
         const Vec2 along_row = found.at(r, std::min(c + 1, grid.cols - 1)) - found.at(r, std::max(c - 1, 0));
@@ -185,11 +206,15 @@ void refine_corners(const cv::Mat& image, CornerRefinement refinement, Grid& gri
         CornerFitOptions options;
         options.radius_px = std::clamp(kFitRadiusShare * spacing, kMinFitRadius, kMaxFitRadius);
         if (const auto fitted = fit_chessboard_corner(image, refined, along_row, along_column, options);
-            fitted && std::hypot((*fitted)[0] - p[0], (*fitted)[1] - p[1]) <= kMaxRefineShare * spacing)
+            fitted && std::hypot((*fitted)[0] - p[0], (*fitted)[1] - p[1]) <= kMaxRefineShare * spacing) {
           refined = *fitted;
+          placed_by = &counts.model_fit;
+        }
       }
+      ++*placed_by;
       grid.px[static_cast<size_t>(r * grid.cols + c)] = refined;
     }
+  return counts;
 }
 
 bool finite_inside(const Vec2& p, int width, int height) {
@@ -245,9 +270,31 @@ std::optional<Vec2> tag_centre(const std::array<Vec2, 4>& corners, const CameraM
 
 }  // namespace
 
+// What each finder's flags are for is said at ChessboardFinder (board_detector.h).
+constexpr int kSbNormalizedFlags = cv::CALIB_CB_NORMALIZE_IMAGE;
+constexpr int kClassicFlags = cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE | cv::CALIB_CB_FAST_CHECK;
+
+const char* chessboard_finder_name(ChessboardFinder finder) {
+  switch (finder) {
+    case ChessboardFinder::mrgingham: return "mrgingham";
+    case ChessboardFinder::sb_exhaustive: return "findChessboardCornersSB";
+    case ChessboardFinder::sb_normalized: return "findChessboardCornersSB (NORMALIZE_IMAGE)";
+    case ChessboardFinder::classic: return "findChessboardCorners";
+  }
+  return "?";
+}
+
+std::vector<ChessboardFinder> chessboard_finders(const CalibrationBoard& board) {
+  std::vector<ChessboardFinder> out;
+  if (board.rows == board.cols) out.push_back(ChessboardFinder::mrgingham);
+  out.insert(out.end(), {ChessboardFinder::sb_exhaustive, ChessboardFinder::sb_normalized, ChessboardFinder::classic});
+  return out;
+}
+
 struct BoardDetector::Impl {
   CalibrationBoard board;
   CornerRefinement refinement = CornerRefinement::model_fit;
+  std::vector<ChessboardFinder> finders;
   std::string method;
   // AprilTag grids only.
   std::unique_ptr<TagDetector> tags;
@@ -255,7 +302,10 @@ struct BoardDetector::Impl {
 
   std::optional<BoardObservation> detect_chessboard(const cv::Mat& image) const;
   std::optional<BoardObservation> detect_mrgingham(const cv::Mat& image) const;
-  std::optional<BoardObservation> detect_sb(const cv::Mat& image) const;
+  std::optional<BoardObservation> detect_sb(const cv::Mat& image, int flags, ChessboardFinder finder) const;
+  std::optional<BoardObservation> detect_classic(const cv::Mat& image) const;
+  std::optional<BoardObservation> from_corners(const std::vector<cv::Point2f>& corners, const cv::Mat& image,
+                                               ChessboardFinder finder) const;
   std::optional<BoardObservation> detect_apriltags(const cv::Mat& image, const CameraModel* lens) const;
   // Refines the corners and puts them in the canonical order.
   std::optional<BoardObservation> observation(Grid grid, const cv::Mat& image, const std::string& detector) const;
@@ -263,10 +313,11 @@ struct BoardDetector::Impl {
 
 std::optional<BoardObservation> BoardDetector::Impl::observation(Grid grid, const cv::Mat& image,
                                                                  const std::string& detector) const {
-  refine_corners(image, refinement, grid);
+  const BoardObservation::Refinements refined = refine_corners(image, refinement, grid);
   grid = canonical_order(grid);
   BoardObservation out;
   out.detector = detector;
+  out.refined = refined;
   out.pixels = std::move(grid.px);
   out.weights = std::move(grid.weights);
   return out;
@@ -298,23 +349,42 @@ std::optional<BoardObservation> BoardDetector::Impl::detect_mrgingham(const cv::
   return out;
 }
 
-std::optional<BoardObservation> BoardDetector::Impl::detect_sb(const cv::Mat& image) const {
-  std::vector<cv::Point2f> corners;
-  if (!cv::findChessboardCornersSB(image, cv::Size(board.cols, board.rows), corners, kSbFlags)) return std::nullopt;
+std::optional<BoardObservation> BoardDetector::Impl::from_corners(const std::vector<cv::Point2f>& corners,
+                                                                  const cv::Mat& image, ChessboardFinder finder) const {
   if (corners.size() != static_cast<size_t>(board.point_count())) return std::nullopt;
   Grid grid{board.rows, board.cols, {}, {}};
   for (const cv::Point2f& p : corners) {
     grid.px.push_back({p.x, p.y});
     grid.weights.push_back(1.0);
   }
-  return observation(std::move(grid), image, "findChessboardCornersSB");
+  return observation(std::move(grid), image, chessboard_finder_name(finder));
+}
+
+std::optional<BoardObservation> BoardDetector::Impl::detect_sb(const cv::Mat& image, int flags,
+                                                               ChessboardFinder finder) const {
+  std::vector<cv::Point2f> corners;
+  if (!cv::findChessboardCornersSB(image, cv::Size(board.cols, board.rows), corners, flags)) return std::nullopt;
+  return from_corners(corners, image, finder);
+}
+
+std::optional<BoardObservation> BoardDetector::Impl::detect_classic(const cv::Mat& image) const {
+  std::vector<cv::Point2f> corners;
+  if (!cv::findChessboardCorners(image, cv::Size(board.cols, board.rows), corners, kClassicFlags)) return std::nullopt;
+  return from_corners(corners, image, ChessboardFinder::classic);
 }
 
 std::optional<BoardObservation> BoardDetector::Impl::detect_chessboard(const cv::Mat& image) const {
-  std::optional<BoardObservation> out;
-  if (board.rows == board.cols) out = detect_mrgingham(image);
-  if (!out) out = detect_sb(image);
-  return out;
+  for (ChessboardFinder finder : finders) {
+    std::optional<BoardObservation> out;
+    switch (finder) {
+      case ChessboardFinder::mrgingham: out = detect_mrgingham(image); break;
+      case ChessboardFinder::sb_exhaustive: out = detect_sb(image, kSbFlags, finder); break;
+      case ChessboardFinder::sb_normalized: out = detect_sb(image, kSbNormalizedFlags, finder); break;
+      case ChessboardFinder::classic: out = detect_classic(image); break;
+    }
+    if (out) return out;
+  }
+  return std::nullopt;
 }
 
 std::optional<BoardObservation> BoardDetector::Impl::detect_apriltags(const cv::Mat& image,
@@ -347,23 +417,25 @@ std::optional<BoardObservation> BoardDetector::Impl::detect_apriltags(const cv::
   out.detector = method;
   out.pixels.resize(static_cast<size_t>(count), kUnseen);
   out.weights.resize(static_cast<size_t>(count), -1.0);
-  std::set<int> rows, cols;
   for (int i = 0; i < count; ++i) {
     // An id seen twice is a false detection somewhere; neither place can be trusted.
     if (hits[static_cast<size_t>(i)] != 1) continue;
     out.pixels[static_cast<size_t>(i)] = centres[static_cast<size_t>(i)];
     out.weights[static_cast<size_t>(i)] = 1.0;
-    rows.insert(i / board.cols);
-    cols.insert(i % board.cols);
   }
-  if (out.seen_count() < std::ceil(kMinSeenFraction * count) || rows.size() < 2 || cols.size() < 2)
-    return std::nullopt;
+  if (!enough_seen(out, board)) return std::nullopt;
   return out;
 }
 
-BoardDetector::BoardDetector(const CalibrationBoard& board, CornerRefinement refinement) : impl_(std::make_unique<Impl>()) {
+BoardDetector::BoardDetector(const CalibrationBoard& board, CornerRefinement refinement,
+                             std::vector<ChessboardFinder> finders)
+    : impl_(std::make_unique<Impl>()) {
   impl_->board = board;
   impl_->refinement = refinement;
+  impl_->finders = finders.empty() ? chessboard_finders(board) : std::move(finders);
+  if (board.rows != board.cols)  // mrgingham finds square boards only
+    std::erase(impl_->finders, ChessboardFinder::mrgingham);
+  if (impl_->finders.empty()) throw BoardError(fmt::format("{}: no chessboard finder applies to this board", board.name));
   if (board.kind == BoardKind::apriltag_grid) {
     impl_->method = "apriltag";
     Config config;
@@ -376,7 +448,7 @@ BoardDetector::BoardDetector(const CalibrationBoard& board, CornerRefinement ref
       throw BoardError(fmt::format("{}: family: cannot detect \"{}\" tags: {}", board.name, board.family, e.what()));
     }
   } else {
-    impl_->method = board.rows == board.cols ? "mrgingham" : "findChessboardCornersSB";
+    impl_->method = chessboard_finder_name(impl_->finders.front());
   }
 }
 
@@ -407,8 +479,15 @@ std::optional<BoardObservation> BoardDetector::find(const unsigned char* grey, i
     else
       out = impl_->detect_chessboard(image);
     if (!out) return std::nullopt;
+    // A point with no place inside the image is dropped (mrcal's convention: weight < 0), not the
+    // view; the view then needs what a partial view needs.
     for (size_t i = 0; i < out->pixels.size(); ++i)
-      if (out->weights[i] > 0 && !finite_inside(out->pixels[i], width, height)) return std::nullopt;
+      if (out->weights[i] > 0 && !finite_inside(out->pixels[i], width, height)) {
+        out->pixels[i] = kUnseen;
+        out->weights[i] = -1.0;
+        ++out->refined.dropped;
+      }
+    if (out->refined.dropped > 0 && !enough_seen(*out, impl_->board)) return std::nullopt;
     out->image = image_name;
     out->width = width;
     out->height = height;

@@ -18,7 +18,16 @@ struct BoardObservation {
   // 1 at full resolution, 2^-level for a corner found at pyramid level `level`.
   std::vector<Vec2> pixels;
   std::vector<double> weights;
-  std::string detector;       // "mrgingham", "findChessboardCornersSB", "apriltag"
+  std::string detector;       // "mrgingham", "findChessboardCornersSB", "findChessboardCorners", "apriltag", ...
+  // Chessboards: how each corner the detector found got its place. The X-junction model fit; else
+  // (the fit failed, or moved it too far) cornerSubPix; else (that too) the detector's own; or
+  // dropped (weight -1: no place inside the image), never the whole view for one corner.
+  struct Refinements {
+    int model_fit = 0;
+    int corner_subpix = 0;
+    int detector = 0;
+    int dropped = 0;
+  } refined;
 
   int seen_count() const;
 };

@@ -48,12 +48,40 @@ CoverageGrid coverage_of(const CalibrationResult& result) {
   return grid;
 }
 
+// "found by: findChessboardCornersSB 10, findChessboardCorners 3; corners placed by the model fit
+// 690, cornerSubPix 12, the finder 0, dropped 0": which detector each view needed, and how its
+// corners were refined (docs/CALIBRATION.md "Finding the board").
+std::string found_by_text(const std::vector<ImageResidual>& images) {
+  std::vector<std::pair<std::string, int>> finders;
+  BoardObservation::Refinements sum;
+  for (const ImageResidual& e : images) {
+    auto it = std::find_if(finders.begin(), finders.end(), [&](const auto& f) { return f.first == e.detector; });
+    if (it == finders.end())
+      finders.emplace_back(e.detector, 1);
+    else
+      ++it->second;
+    sum.model_fit += e.refined.model_fit;
+    sum.corner_subpix += e.refined.corner_subpix;
+    sum.detector += e.refined.detector;
+    sum.dropped += e.refined.dropped;
+  }
+  std::string s = "found by:";
+  for (size_t i = 0; i < finders.size(); ++i)
+    s += fmt::format("{} {} {}", i ? "," : "", finders[i].first, finders[i].second);
+  if (sum.model_fit + sum.corner_subpix + sum.detector + sum.dropped > 0)
+    s += fmt::format("; corners placed by the model fit {}, cornerSubPix {}, the finder {}, dropped {}", sum.model_fit,
+                     sum.corner_subpix, sum.detector, sum.dropped);
+  return s + "\n";
+}
+
 std::vector<ImageResidual> residuals_per_image(const CalibrationResult& result) {
   std::vector<ImageResidual> out;
   for (size_t v = 0; v < result.observations.size(); ++v) {
     const BoardObservation& obs = result.observations[v];
     ImageResidual r;
     r.image = obs.image;
+    r.detector = obs.detector;
+    r.refined = obs.refined;
     double sum2 = 0;
     for (size_t i = 0; i < obs.pixels.size(); ++i) {
       const Vec2& e = result.residuals_px[v][i];
@@ -168,6 +196,7 @@ std::string report_text(const CalibrationReport& r) {
       "residuals: RMS {:.3f} px per point ({:.3f} px per coordinate, mrcal's figure); {} inliers, {} outliers\n",
       r.rms_per_point_px, r.rms_per_coordinate_px, r.inliers, r.outliers);
   s += fmt::format("board warp: {:.2f} mm along x, {:.2f} mm along y\n", 1e3 * r.board_warp_x_m, 1e3 * r.board_warp_y_m);
+  s += found_by_text(r.per_image);
   s += "worst images (RMS, max px):\n";
   for (int i : r.worst_images) {
     const ImageResidual& e = r.per_image[size_t(i)];
@@ -210,7 +239,9 @@ std::string report_json(const CalibrationReport& r) {
   auto& images = j["per_image"] = nlohmann::ordered_json::array();
   for (const ImageResidual& e : r.per_image)
     images.push_back({{"image", e.image}, {"points", e.points}, {"outliers", e.outliers}, {"rms_px", e.rms_px},
-                      {"max_px", e.max_px}});
+                      {"max_px", e.max_px}, {"detector", e.detector},
+                      {"corners_placed_by", {{"model_fit", e.refined.model_fit}, {"corner_subpix", e.refined.corner_subpix},
+                                             {"detector", e.refined.detector}, {"dropped", e.refined.dropped}}}});
   j["worst_images"] = r.worst_images;
   j["coverage"] = {{"cols", r.coverage.cols},
                    {"rows", r.coverage.rows},

@@ -17,6 +17,8 @@ struct ImageResidual {
   int outliers = 0;
   double rms_px = 0;          // per point (|residual| over its x and y), inliers, unweighted
   double max_px = 0;
+  std::string detector;       // the finder that found the board in it (BoardObservation::detector)
+  BoardObservation::Refinements refined;  // chessboards: how its corners were placed
 };
 
 // The image cut into cols x rows cells; a cell is covered when at least one inlier point fell in it.

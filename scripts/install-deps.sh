@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
 # The one list of Debian 12 packages arpipe needs to build, run and test.
-# Usage: scripts/install-deps.sh   (as root, or with sudo available)
+# Usage: scripts/install-deps.sh [--tests]   (as root, or with sudo available)
+# --tests adds what only the tests need (scripts/test.sh passes it; the quick start does not).
 set -euo pipefail
+with_tests=0
+if [ "${1:-}" = "--tests" ]; then with_tests=1; fi
 
 packages=(
   # toolchain
@@ -46,8 +49,26 @@ packages=(
   libgstrtspserver-1.0-dev
 )
 
+# Only for the tests: OpenCV's 13 sample photographs of a chessboard (tests/calib/real_photographs_test.cpp).
+test_packages=(opencv-doc)
+photographs=/usr/share/doc/opencv-doc/examples/data
+if [ "$with_tests" = 1 ]; then packages+=("${test_packages[@]}"); fi
+
 sudo_cmd=()
 if [ "$(id -u)" -ne 0 ]; then sudo_cmd=(sudo); fi
+
+# A minimal image's dpkg config may leave out /usr/share/doc: then the photographs are unpacked
+# from the package itself.
+unpack_photographs() {
+  if [ "$with_tests" = 1 ] && [ ! -f "$photographs/left01.jpg" ]; then
+    local tmp
+    tmp=$(mktemp -d)
+    (cd "$tmp" && apt-get download -qq opencv-doc)
+    dpkg-deb --fsys-tarfile "$tmp"/opencv-doc_*.deb |
+      "${sudo_cmd[@]}" tar -x -C / --wildcards ".$photographs/left*.jpg"
+    rm -rf "$tmp"
+  fi
+}
 
 export DEBIAN_FRONTEND=noninteractive
 missing=()
@@ -56,8 +77,10 @@ for p in "${packages[@]}"; do
 done
 if [ ${#missing[@]} -eq 0 ]; then
   echo "install-deps: all ${#packages[@]} packages already installed"
+  unpack_photographs
   exit 0
 fi
 echo "install-deps: installing ${missing[*]}"
 "${sudo_cmd[@]}" apt-get update -qq
 "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+unpack_photographs
