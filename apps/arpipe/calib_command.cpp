@@ -98,7 +98,8 @@ void add_calib_command(CLI::App& arpipe) {
   CLI::App* command = arpipe.add_subcommand(
       "calib", "calibrate a camera's lens with mrcal from views of a board (configs/boards/), with a report");
   command->footer(
-      "Finds the board in every image, solves the lens with mrcal and writes CAMERA.cameramodel, and beside it\n"
+      "Finds the board in every image, solves the lens with mrcal and writes CAMERA.cameramodel (with mrcal's\n"
+      "optimization_inputs, for mrcal-show-projection-uncertainty and friends), and beside it\n"
       "CAMERA.report.txt, CAMERA.report.json, CAMERA.residuals.png and CAMERA.corners.vnl (mrcal's corners\n"
       "cache). docs/CALIBRATION.md says how to take the images.");
   auto options = std::make_shared<CalibOptions>();
