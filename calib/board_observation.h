@@ -20,8 +20,9 @@ struct BoardObservation {
   std::vector<double> weights;
   std::string detector;       // "mrgingham", "findChessboardCornersSB", "findChessboardCorners", "apriltag", ...
   // Chessboards: how each corner the detector found got its place. The X-junction model fit; else
-  // (the fit failed, or moved it too far) cornerSubPix; else (that too) the detector's own; or
-  // dropped (weight -1: no place inside the image), never the whole view for one corner.
+  // (the fit failed, or moved it too far) cornerSubPix; the finder's own only without refinement;
+  // or dropped (weight -1: cornerSubPix found no junction near the finder's place, or no place
+  // inside the image), never the whole view for one corner while 60 % of the board is left.
   struct Refinements {
     int model_fit = 0;
     int corner_subpix = 0;

@@ -58,16 +58,6 @@ CalibrationBoard chessboard(int rows, int cols, double square_m = 0.02) {
   return board;
 }
 
-// The detector's promised order (calib/board_detector.cpp, canonical_order): the board seen from
-// its printed side, rows running left to right in the image. The truth grid is given row by row
-// with x along a row, so it is that order itself or, when its rows run right to left, turned.
-std::vector<Vec2> in_detector_order(const std::vector<Vec2>& truth, int cols) {
-  double dx = 0;
-  for (size_t i = 0; i + 1 < truth.size(); ++i)
-    if ((i + 1) % cols != 0) dx += truth[i + 1][0] - truth[i][0];
-  return dx >= 0 ? truth : turned(truth);
-}
-
 std::optional<BoardObservation> detect(const BoardDetector& detector, const GreyImage& image) {
   return detector.detect(image.pixels.data(), image.width, image.height, static_cast<size_t>(image.width), image.name);
 }

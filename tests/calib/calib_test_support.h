@@ -92,6 +92,16 @@ inline std::vector<Vec2> true_pixels(const RecordingReader& reader, size_t index
 // The same grid read backwards (a 180-degree turn of the board).
 inline std::vector<Vec2> turned(const std::vector<Vec2>& points) { return {points.rbegin(), points.rend()}; }
 
+// The detector's promised order (calib/board_detector.cpp, canonical_order): the board seen from
+// its printed side, rows running left to right in the image. The truth grid is given row by row
+// with x along a row, so it is that order itself or, when its rows run right to left, turned.
+inline std::vector<Vec2> in_detector_order(const std::vector<Vec2>& truth, int cols) {
+  double dx = 0;
+  for (size_t i = 0; i + 1 < truth.size(); ++i)
+    if ((i + 1) % cols != 0) dx += truth[i + 1][0] - truth[i][0];
+  return dx >= 0 ? truth : turned(truth);
+}
+
 struct CornerErrors {
   double rms_px = 0;  // per point: sqrt(mean |detected - true|^2) over the seen points
   double max_px = 0;
