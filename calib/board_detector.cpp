@@ -196,9 +196,9 @@ BoardObservation::Refinements refine_corners(const cv::Mat& image, CornerRefinem
       if (!std::isfinite(refined[0]) || !std::isfinite(refined[1]) ||
           std::hypot(refined[0] - p[0], refined[1] - p[1]) > kMaxRefineShare * spacing) {
         // No junction near the finder's place, or the window slid to another: the finder's place
-        // is not a corner to trust (measured on the calib-board-photo capture: the classic
-        // finder's corners kept this way were off by 2.6-9.8 px). Dropped, mrcal's outlier way;
-        // its pixel stays until the grid is ordered.
+        // is not a corner to trust. Dropped, mrcal's outlier way (never on the calib-board and
+        // calib-board-photo captures, whose corners all get the model fit); its pixel stays until
+        // the grid is ordered.
         grid.weights[static_cast<size_t>(r * grid.cols + c)] = -1.0;
         ++counts.dropped;
         continue;
