@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <opencv2/aruco/charuco.hpp>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 #include <set>
@@ -76,6 +77,13 @@ constexpr double kMaxFitRadius = 10;
 // corners, where the lens distortion is largest and observations are scarcest.
 constexpr double kMinSeenFraction = 0.6;
 
+// A ChArUco view needs at least this many corners, over two rows and two columns (so not all on
+// one line of the board). Every corner is named by the markers beside it, so any subset is
+// unambiguous, and the 60 % above would throw away exactly the views that reach into the image's
+// corners with most of the board outside the image. Why this number: measured in
+// tests/calib/charuco_calibration_test.cpp (docs/CALIBRATION.md, "ChArUco boards").
+constexpr int kMinCharucoCorners = 8;
+
 // libapriltag's decision margin below which a detection is not trusted (the tracker's default).
 constexpr double kMinDecisionMargin = 20.0;
 // Quads found at full resolution: calibration tags are small. Measured on a 5 x 6 grid of 30 mm
@@ -88,6 +96,7 @@ constexpr Vec2 kUnseen{-1.0, -1.0};
 
 // Whether a view with points missing still counts: kMinSeenFraction of the board's points, over
 // at least two rows and two columns.
+// ChArUco boards: kMinCharucoCorners of them, over two rows and two columns.
 bool enough_seen(const BoardObservation& view, const CalibrationBoard& board) {
   std::set<int> rows, cols;
   for (size_t i = 0; i < view.weights.size(); ++i)
@@ -95,7 +104,9 @@ bool enough_seen(const BoardObservation& view, const CalibrationBoard& board) {
       rows.insert(int(i) / board.cols);
       cols.insert(int(i) % board.cols);
     }
-  return view.seen_count() >= std::ceil(kMinSeenFraction * board.point_count()) && rows.size() >= 2 && cols.size() >= 2;
+  const double minimum =
+      board.kind == BoardKind::charuco ? kMinCharucoCorners : std::ceil(kMinSeenFraction * board.point_count());
+  return view.seen_count() >= minimum && rows.size() >= 2 && cols.size() >= 2;
 }
 
 // A rows x cols grid of detected points in row-major order (index r*cols + c).
@@ -172,45 +183,84 @@ Grid canonical_order(const Grid& grid) {
 // edges' directions from the neighbouring corners. A corner either step moves farther than
 // kMaxRefineShare of the distance to its nearest neighbour has slid towards another junction and
 // keeps its place from before that step.
-BoardObservation::Refinements refine_corners(const cv::Mat& image, CornerRefinement refinement, Grid& grid) {
+// How far refinement may reach around a corner, as shares of the distance to its nearest
+// neighbour. A chessboard's nearest other feature is the next junction; a ChArUco board's is the
+// nearest marker corner, sqrt(2) x the gap between marker and square from the corner.
+struct RefineReach {
+  bool corner_subpix = true;               // false: the corners come cornerSubPix-refined already
+  double window_share = kRefineWindowShare;
+  double fit_radius_share = kFitRadiusShare;
+};
+
+// Sub-pixel corners: cornerSubPix (gradients orthogonal to the corner-to-pixel vector over a
+// window), on the image as it came, then optionally the X-junction model fit from there, with the
+// edges' directions from the neighbouring corners. A corner either step moves farther than
+// kMaxRefineShare of the distance to its nearest neighbour has slid towards another junction and
+// keeps its place from before that step. Points with weight <= 0 (not seen) are left alone and are
+// nobody's neighbour; a corner with no seen neighbour takes `fallback_spacing` (px) as that
+// distance, and the model fit needs a seen neighbour along its row and along its column.
+BoardObservation::Refinements refine_corners(const cv::Mat& image, CornerRefinement refinement, Grid& grid,
+                                             const RefineReach& reach = {},
+                                             double fallback_spacing = std::numeric_limits<double>::infinity()) {
   BoardObservation::Refinements counts;
   if (refinement == CornerRefinement::none) {
-    counts.detector = int(grid.px.size());
+    for (double w : grid.weights) counts.detector += w > 0;
     return counts;
   }
   const cv::TermCriteria stop(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50, 0.001);
   const Grid found = grid;
+  const auto seen = [&found](int r, int c) {
+    return r >= 0 && r < found.rows && c >= 0 && c < found.cols && found.weights[size_t(r * found.cols + c)] > 0;
+  };
   for (int r = 0; r < grid.rows; ++r)
     for (int c = 0; c < grid.cols; ++c) {
+      if (!seen(r, c)) continue;
       double spacing = std::numeric_limits<double>::infinity();
       const Vec2& p = found.at(r, c);
       for (const auto& [dr, dc] : {std::pair{-1, 0}, {1, 0}, {0, -1}, {0, 1}}) {
-        if (r + dr < 0 || r + dr >= grid.rows || c + dc < 0 || c + dc >= grid.cols) continue;
+        if (!seen(r + dr, c + dc)) continue;
         const Vec2& q = found.at(r + dr, c + dc);
         spacing = std::min(spacing, std::hypot(q[0] - p[0], q[1] - p[1]));
       }
-      const int window = std::clamp(static_cast<int>(kRefineWindowShare * spacing), kMinRefineWindow, kMaxRefineWindow);
-      std::vector<cv::Point2f> corner{cv::Point2f(static_cast<float>(p[0]), static_cast<float>(p[1]))};
-      cv::cornerSubPix(image, corner, cv::Size(window, window), cv::Size(-1, -1), stop);
-      Vec2 refined{corner[0].x, corner[0].y};
-      if (!std::isfinite(refined[0]) || !std::isfinite(refined[1]) ||
-          std::hypot(refined[0] - p[0], refined[1] - p[1]) > kMaxRefineShare * spacing) {
-        // No junction near the finder's place, or the window slid to another: the finder's place
-        // is not a corner to trust. Dropped, mrcal's outlier way (never on the calib-board and
-        // calib-board-photo captures, whose corners all get the model fit); its pixel stays until
-        // the grid is ordered.
+      if (!std::isfinite(spacing)) spacing = fallback_spacing;
+      if (!std::isfinite(spacing)) {  // nothing says how large the squares are here
         grid.weights[static_cast<size_t>(r * grid.cols + c)] = -1.0;
         ++counts.dropped;
         continue;
       }
-      int* placed_by = &counts.corner_subpix;
-      if (refinement == CornerRefinement::model_fit) {
-        // The edges through the corner run towards the neighbours in its row and its column.
-        const Vec2 along_row = found.at(r, std::min(c + 1, grid.cols - 1)) - found.at(r, std::max(c - 1, 0));
-        const Vec2 along_column = found.at(std::min(r + 1, grid.rows - 1), c) - found.at(std::max(r - 1, 0), c);
+      Vec2 refined = p;
+      int* placed_by = &counts.detector;
+      if (reach.corner_subpix) {
+        const int window =
+            std::clamp(static_cast<int>(reach.window_share * spacing), kMinRefineWindow, kMaxRefineWindow);
+        std::vector<cv::Point2f> corner{cv::Point2f(static_cast<float>(p[0]), static_cast<float>(p[1]))};
+        cv::cornerSubPix(image, corner, cv::Size(window, window), cv::Size(-1, -1), stop);
+        refined = {corner[0].x, corner[0].y};
+        if (!std::isfinite(refined[0]) || !std::isfinite(refined[1]) ||
+            std::hypot(refined[0] - p[0], refined[1] - p[1]) > kMaxRefineShare * spacing) {
+          // No junction near the finder's place, or the window slid to another: the finder's place
+          // is not a corner to trust. Dropped, mrcal's outlier way (never on the calib-board and
+          // calib-board-photo captures, whose corners all get the model fit); its pixel stays until
+          // the grid is ordered.
+          grid.weights[static_cast<size_t>(r * grid.cols + c)] = -1.0;
+          ++counts.dropped;
+          continue;
+        }
+        placed_by = &counts.corner_subpix;
+      }
+      // The edges through the corner run towards the neighbours in its row and its column.
+      const auto direction = [&](int r0, int c0, int r1, int c1) -> std::optional<Vec2> {
+        const Vec2& a = seen(r0, c0) ? found.at(r0, c0) : p;
+        const Vec2& b = seen(r1, c1) ? found.at(r1, c1) : p;
+        if (!seen(r0, c0) && !seen(r1, c1)) return std::nullopt;
+        return b - a;
+      };
+      const auto along_row = direction(r, c - 1, r, c + 1);
+      const auto along_column = direction(r - 1, c, r + 1, c);
+      if (refinement == CornerRefinement::model_fit && along_row && along_column) {
         CornerFitOptions options;
-        options.radius_px = std::clamp(kFitRadiusShare * spacing, kMinFitRadius, kMaxFitRadius);
-        if (const auto fitted = fit_chessboard_corner(image, refined, along_row, along_column, options);
+        options.radius_px = std::clamp(reach.fit_radius_share * spacing, kMinFitRadius, kMaxFitRadius);
+        if (const auto fitted = fit_chessboard_corner(image, refined, *along_row, *along_column, options);
             fitted && std::hypot((*fitted)[0] - p[0], (*fitted)[1] - p[1]) <= kMaxRefineShare * spacing) {
           refined = *fitted;
           placed_by = &counts.model_fit;
@@ -312,6 +362,10 @@ struct BoardDetector::Impl {
   std::optional<BoardObservation> from_corners(const std::vector<cv::Point2f>& corners, const cv::Mat& image,
                                                ChessboardFinder finder) const;
   std::optional<BoardObservation> detect_apriltags(const cv::Mat& image, const CameraModel* lens) const;
+  // ChArUco boards only.
+  cv::Ptr<cv::aruco::CharucoBoard> charuco;
+  cv::Ptr<cv::aruco::DetectorParameters> aruco_parameters;
+  std::optional<BoardObservation> detect_charuco(const cv::Mat& image) const;
   // Refines the corners and puts them in the canonical order.
   std::optional<BoardObservation> observation(Grid grid, const cv::Mat& image, const std::string& detector) const;
 };
@@ -434,6 +488,58 @@ std::optional<BoardObservation> BoardDetector::Impl::detect_apriltags(const cv::
   return out;
 }
 
+// ChArUco: the markers by OpenCV's detectMarkers (then refineDetectedMarkers, which looks for the
+// board's missing markers where the found ones say they are), the corners between them by
+// interpolateCornersCharuco (each from the homography of its neighbouring markers, then
+// cornerSubPix with a window clear of the markers), then the X-junction model fit with a radius
+// that stays clear of the markers too. The lens is not used: the model fit places each corner
+// from the pixels around it, wherever the interpolation put its first guess.
+std::optional<BoardObservation> BoardDetector::Impl::detect_charuco(const cv::Mat& image) const {
+  std::vector<std::vector<cv::Point2f>> markers, rejected;
+  std::vector<int> ids;
+  cv::aruco::detectMarkers(image, charuco->dictionary, markers, ids, aruco_parameters, rejected);
+  if (ids.empty()) return std::nullopt;
+  cv::aruco::refineDetectedMarkers(image, charuco, markers, ids, rejected);
+  std::vector<cv::Point2f> corners;
+  std::vector<int> corner_ids;
+  cv::aruco::interpolateCornersCharuco(markers, ids, image, charuco, corners, corner_ids);
+  const int count = board.point_count();
+  Grid grid{board.rows, board.cols, std::vector<Vec2>(size_t(count), kUnseen), std::vector<double>(size_t(count), -1.0)};
+  std::vector<int> hits(size_t(count), 0);
+  for (size_t k = 0; k < corner_ids.size() && k < corners.size(); ++k) {
+    const int id = corner_ids[k];
+    if (id < 0 || id >= count) continue;
+    ++hits[size_t(id)];
+    grid.px[size_t(id)] = {corners[k].x, corners[k].y};
+    grid.weights[size_t(id)] = hits[size_t(id)] == 1 ? 1.0 : -1.0;  // an id twice: neither place is trusted
+  }
+  // A corner with no seen neighbour: the squares' size there from the markers' (marker edge / marker_m * square_m).
+  double marker_edges = 0;
+  int edges = 0;
+  for (const auto& m : markers)
+    for (size_t k = 0; k < 4; ++k) {
+      marker_edges += std::hypot(m[(k + 1) % 4].x - m[k].x, m[(k + 1) % 4].y - m[k].y);
+      ++edges;
+    }
+  const double fallback = edges > 0 ? marker_edges / edges * board.spacing_m / board.marker_m
+                                    : std::numeric_limits<double>::infinity();
+  RefineReach reach;
+  reach.corner_subpix = false;  // interpolateCornersCharuco ran cornerSubPix, its window clear of the markers
+  // The nearest marker corner is sqrt(2) x the gap from the square's corner; the model's window
+  // keeps a quarter of that clear for the blur.
+  const double gap_share = (board.spacing_m - board.marker_m) / 2 / board.spacing_m;
+  reach.fit_radius_share = std::min(kFitRadiusShare, 0.75 * std::sqrt(2.0) * gap_share);
+  BoardObservation out;
+  out.refined = refine_corners(image, refinement, grid, reach, fallback);
+  for (size_t i = 0; i < grid.px.size(); ++i)
+    if (grid.weights[i] <= 0) grid.px[i] = kUnseen;
+  out.detector = method;
+  out.pixels = std::move(grid.px);
+  out.weights = std::move(grid.weights);
+  if (!enough_seen(out, board)) return std::nullopt;
+  return out;
+}
+
 BoardDetector::BoardDetector(const CalibrationBoard& board, CornerRefinement refinement,
                              std::vector<ChessboardFinder> finders)
     : impl_(std::make_unique<Impl>()) {
@@ -454,6 +560,12 @@ BoardDetector::BoardDetector(const CalibrationBoard& board, CornerRefinement ref
     } catch (const std::exception& e) {  // a board made in code with a family libapriltag lacks
       throw BoardError(fmt::format("{}: family: cannot detect \"{}\" tags: {}", board.name, board.family, e.what()));
     }
+  } else if (board.kind == BoardKind::charuco) {
+    impl_->method = "charuco";
+    impl_->charuco = cv::aruco::CharucoBoard::create(board.cols + 1, board.rows + 1, float(board.spacing_m),
+                                                     float(board.marker_m),
+                                                     cv::aruco::getPredefinedDictionary(board.dictionary_id));
+    impl_->aruco_parameters = cv::aruco::DetectorParameters::create();
   } else {
     impl_->method = chessboard_finder_name(impl_->finders.front());
   }
@@ -483,6 +595,8 @@ std::optional<BoardObservation> BoardDetector::find(const unsigned char* grey, i
     std::optional<BoardObservation> out;
     if (impl_->method == "apriltag")
       out = impl_->detect_apriltags(image, lens);
+    else if (impl_->method == "charuco")
+      out = impl_->detect_charuco(image);
     else
       out = impl_->detect_chessboard(image);
     if (!out) return std::nullopt;

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <opencv2/aruco/charuco.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -65,6 +66,34 @@ cv::Mat draw_apriltag_grid(const CalibrationBoard& board, double px_per_m) {
   return image;
 }
 
+// ChArUco: the chessboard above (top-left square dark) with a marker drawn by OpenCV
+// (cv::aruco::drawMarker, one black border bit) centred in each light square, marker i in the i-th
+// light square along the rows: cv::aruco::CharucoBoard's layout, so its interpolation numbers the
+// inner corners row by row. Every edge is rounded to whole pixels like the chessboard's, so the
+// squares are exact to the pixel at any dpi (CharucoBoard::draw scales the board to one size).
+cv::Mat draw_charuco(const CalibrationBoard& board, double px_per_m) {
+  cv::Mat image = draw_chessboard(board, px_per_m);
+  const auto at = [&](double metres) { return int(std::lround(metres * px_per_m)); };
+  const double s = board.spacing_m;
+  const double inset = (s - board.marker_m) / 2;
+  const cv::Ptr<cv::aruco::Dictionary> dictionary = cv::aruco::getPredefinedDictionary(board.dictionary_id);
+  int id = 0;
+  for (int y = 0; y <= board.rows; ++y)
+    for (int x = 0; x <= board.cols; ++x) {
+      if ((x + y) % 2 == 0) continue;  // dark square
+      const int left = at((x + 1) * s + inset);
+      const int top = at((y + 1) * s + inset);
+      const int side = std::min(at((x + 1) * s + inset + board.marker_m) - left,
+                                at((y + 1) * s + inset + board.marker_m) - top);
+      if (id >= dictionary->bytesList.rows)
+        throw BoardError(fmt::format("{}: {} has no marker {}", board.name, board.dictionary, id));
+      cv::Mat marker;
+      cv::aruco::drawMarker(dictionary, id++, side, marker, 1);
+      marker.copyTo(image(cv::Rect(left, top, side, side)));
+    }
+  return image;
+}
+
 }  // namespace
 
 PrintedBoard write_board_png(const CalibrationBoard& board, const std::filesystem::path& png, double dots_per_inch) {
@@ -73,7 +102,8 @@ PrintedBoard write_board_png(const CalibrationBoard& board, const std::filesyste
                                  dots_per_inch));
   const double px_per_m = dots_per_inch / kMetresPerInch;
   const cv::Mat image = board.kind == BoardKind::chessboard ? draw_chessboard(board, px_per_m)
-                                                            : draw_apriltag_grid(board, px_per_m);
+                         : board.kind == BoardKind::charuco  ? draw_charuco(board, px_per_m)
+                                                             : draw_apriltag_grid(board, px_per_m);
   bool written = false;
   try {
     written = cv::imwrite(png.string(), image);

@@ -16,7 +16,7 @@ struct PrintedBoard {
 };
 
 // Writes a grey PNG with `dots_per_inch` pixels per printed inch (print it at that resolution, at
-// 100 %, not fitted to the page), with one square (chessboard) or one tag gap plus a border cell
+// 100 %, not fitted to the page), with one square (chessboard, ChArUco) or one tag gap plus a border cell
 // (AprilTag grid) of white margin.
 // Throws BoardError naming the file when it cannot be written or the family is unknown.
 PrintedBoard write_board_png(const CalibrationBoard& board, const std::filesystem::path& png, double dots_per_inch);

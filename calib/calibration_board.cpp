@@ -4,6 +4,7 @@
 #include "calib/calibration_board.h"
 
 #include <apriltag/apriltag.h>
+#include <opencv2/aruco/dictionary.hpp>
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
@@ -27,6 +28,7 @@ constexpr int64_t kMaxGridPoints = 1000;
 const std::vector<std::string_view> kChessboardKeys{"kind", "description", "inner_corners", "square_m"};
 const std::vector<std::string_view> kAprilGridKeys{"kind",          "description", "tags",    "tag_size_m",
                                                    "tag_spacing_m", "family",      "first_id"};
+const std::vector<std::string_view> kCharucoKeys{"kind", "description", "squares", "square_m", "marker_m", "dictionary"};
 
 // Board keys have no defaults but for family and first_id: an absent one is "found nothing".
 void require(const TomlSection& s, std::string_view key, const std::string& expected) {
@@ -96,23 +98,77 @@ void read_apriltag_grid(const TomlSection& s, CalibrationBoard& board) {
   board.first_id = s.integer_as<int>("first_id", 0, IntRange{0, last_first_id});
 }
 
+void read_charuco(const TomlSection& s, CalibrationBoard& board) {
+  // Three squares each way at least, so that there are two rows and two columns of inner corners.
+  const auto [square_rows, square_cols] = grid(s, "squares", "squares");
+  if (square_rows < 3 || square_cols < 3)
+    s.fail("squares", "at least 3 squares each way (2 x 2 inner corners)",
+           fmt::format("{} x {}", square_rows, square_cols));
+  board.rows = square_rows - 1;
+  board.cols = square_cols - 1;
+  board.spacing_m = metres(s, "square_m");
+  board.marker_m = metres(s, "marker_m");
+  if (!(board.marker_m < board.spacing_m))
+    s.fail("marker_m", fmt::format("less than square_m ({:g} m): the marker sits inside a light square", board.spacing_m),
+           fmt::format("{:g}", board.marker_m));
+  std::string names;
+  for (const auto& d : aruco_dictionary_names()) names += (names.empty() ? "" : ", ") + std::string(d.name);
+  require(s, "dictionary", "one of " + names);
+  board.dictionary = s.string("dictionary", "");
+  const auto& known = aruco_dictionary_names();
+  const auto it = std::find_if(known.begin(), known.end(), [&](const auto& d) { return board.dictionary == d.name; });
+  if (it == known.end()) s.fail("dictionary", "one of " + names, toml_quoted(board.dictionary));
+  board.dictionary_id = it->id;
+  // One marker in every light square: half the squares, rounded down (the top-left one is dark).
+  const int markers = square_rows * square_cols / 2;
+  const int codes = cv::aruco::getPredefinedDictionary(board.dictionary_id)->bytesList.rows;
+  if (markers > codes)
+    s.fail("squares", fmt::format("at most {} markers ({} has {} codes; a board has one per light square)", codes,
+                                  board.dictionary, codes),
+           fmt::format("{} x {} squares, {} markers", square_rows, square_cols, markers));
+}
+
 CalibrationBoard read_board(const TomlSection& file) {
   CalibrationBoard board;
   board.name = fs::path(file.source_name()).stem().string();
   require(file, "kind", "one of " + choice_list<BoardKind>(kBoardKindNames));
   board.kind = file.choice("kind", BoardKind::chessboard, kBoardKindNames);
   // The kind decides which keys belong: a key of the other kind is named before any value is read.
-  for (const auto key : board.kind == BoardKind::chessboard ? kChessboardKeys : kAprilGridKeys) file.allow(key);
+  const auto& keys = board.kind == BoardKind::chessboard ? kChessboardKeys
+                     : board.kind == BoardKind::charuco  ? kCharucoKeys
+                                                         : kAprilGridKeys;
+  for (const auto key : keys) file.allow(key);
   file.reject_stray_keys();
   file.string("description", "");  // checked for its type only
   if (board.kind == BoardKind::chessboard)
     read_chessboard(file, board);
+  else if (board.kind == BoardKind::charuco)
+    read_charuco(file, board);
   else
     read_apriltag_grid(file, board);
   return board;
 }
 
 }  // namespace
+
+const std::vector<ArucoDictionaryName>& aruco_dictionary_names() {
+  using namespace cv::aruco;
+  static const std::vector<ArucoDictionaryName> names{
+      {"DICT_4X4_50", DICT_4X4_50},     {"DICT_4X4_100", DICT_4X4_100},
+      {"DICT_4X4_250", DICT_4X4_250},   {"DICT_4X4_1000", DICT_4X4_1000},
+      {"DICT_5X5_50", DICT_5X5_50},     {"DICT_5X5_100", DICT_5X5_100},
+      {"DICT_5X5_250", DICT_5X5_250},   {"DICT_5X5_1000", DICT_5X5_1000},
+      {"DICT_6X6_50", DICT_6X6_50},     {"DICT_6X6_100", DICT_6X6_100},
+      {"DICT_6X6_250", DICT_6X6_250},   {"DICT_6X6_1000", DICT_6X6_1000},
+      {"DICT_7X7_50", DICT_7X7_50},     {"DICT_7X7_100", DICT_7X7_100},
+      {"DICT_7X7_250", DICT_7X7_250},   {"DICT_7X7_1000", DICT_7X7_1000},
+      {"DICT_ARUCO_ORIGINAL", DICT_ARUCO_ORIGINAL},
+      {"DICT_APRILTAG_16h5", DICT_APRILTAG_16h5},
+      {"DICT_APRILTAG_25h9", DICT_APRILTAG_25h9},
+      {"DICT_APRILTAG_36h10", DICT_APRILTAG_36h10},
+      {"DICT_APRILTAG_36h11", DICT_APRILTAG_36h11}};
+  return names;
+}
 
 std::vector<Vec3> CalibrationBoard::points() const {
   std::vector<Vec3> out;

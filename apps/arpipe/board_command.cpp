@@ -25,10 +25,14 @@ int draw_board(const BoardOptions& options) {
   const double dpi = options.dpi;
   const calib::CalibrationBoard board = calib::load_board(board_path);
   const calib::PrintedBoard printed = calib::write_board_png(board, out, dpi);
-  fmt::print("wrote {}: {}x{} px; print at {:g} dpi, 100 % scale: {:.1f} x {:.1f} mm with the margin; {} {:.1f} mm\n",
+  const bool tags = board.kind == calib::BoardKind::apriltag_grid;
+  fmt::print("wrote {}: {}x{} px; print at {:g} dpi, 100 % scale: {:.1f} x {:.1f} mm with the margin; {} {:.1f} mm",
              out, printed.width_px, printed.height_px, dpi, 1e3 * printed.width_m, 1e3 * printed.height_m,
-             board.kind == calib::BoardKind::chessboard ? "each square must measure" : "each tag's black square must measure",
-             1e3 * (board.kind == calib::BoardKind::chessboard ? board.spacing_m : board.tag_size_m));
+             tags ? "each tag's black square must measure" : "each square must measure",
+             1e3 * (tags ? board.tag_size_m : board.spacing_m));
+  if (board.kind == calib::BoardKind::charuco)
+    fmt::print(", each marker's black square {:.1f} mm", 1e3 * board.marker_m);
+  fmt::print("\n");
   return 0;
 }
 

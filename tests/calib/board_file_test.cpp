@@ -106,7 +106,7 @@ TEST(BoardFile, WrongTypesAreNamed) {
             "integers >= 2, found a string");
   EXPECT_EQ(error_of(kChess + "inner_corners = [9, 13.0]\nsquare_m = 0.02\n"),
             "b.toml:2:21: inner_corners[1]: expected an integer in [2, 1000], found a float");
-  EXPECT_EQ(error_of("kind = 1\n"), "b.toml:1:8: kind: expected one of \"chessboard\", \"apriltag_grid\", found an integer");
+  EXPECT_EQ(error_of("kind = 1\n"), "b.toml:1:8: kind: expected one of \"chessboard\", \"apriltag_grid\", \"charuco\", found an integer");
   EXPECT_EQ(error_of(kGrid + "tags = [3, 4]\ntag_size_m = 0.04\ntag_spacing_m = 0.01\nfirst_id = 1.5\n"),
             "b.toml:5:12: first_id: expected an integer in [0, 575], found a float");
   EXPECT_EQ(error_of(kChess + "inner_corners = [9, 13]\nsquare_m = 0.02\ndescription = 3\n"),
@@ -115,7 +115,7 @@ TEST(BoardFile, WrongTypesAreNamed) {
 
 TEST(BoardFile, MissingKeysAreNamed) {
   EXPECT_EQ(error_of("inner_corners = [9, 13]\nsquare_m = 0.02\n"),
-            "b.toml:1:1: kind: expected one of \"chessboard\", \"apriltag_grid\", found nothing");
+            "b.toml:1:1: kind: expected one of \"chessboard\", \"apriltag_grid\", \"charuco\", found nothing");
   EXPECT_EQ(error_of(kChess + "inner_corners = [9, 13]\n"),
             "b.toml:1:1: square_m: expected a number > 0 (m), found nothing");
   EXPECT_EQ(error_of(kChess + "square_m = 0.02\n"),
@@ -126,7 +126,7 @@ TEST(BoardFile, MissingKeysAreNamed) {
 }
 
 TEST(BoardFile, BadValuesAreNamed) {
-  EXPECT_EQ(error_of("kind = \"circles\"\n"), "b.toml:1:8: kind: expected one of \"chessboard\", \"apriltag_grid\", found \"circles\"");
+  EXPECT_EQ(error_of("kind = \"circles\"\n"), "b.toml:1:8: kind: expected one of \"chessboard\", \"apriltag_grid\", \"charuco\", found \"circles\"");
   EXPECT_EQ(error_of(kChess + "inner_corners = [1, 13]\nsquare_m = 0.02\n"),
             "b.toml:2:18: inner_corners[0]: expected an integer in [2, 1000], found 1");
   EXPECT_EQ(error_of(kChess + "inner_corners = [9, 13, 2]\nsquare_m = 0.02\n"),

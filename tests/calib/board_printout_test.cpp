@@ -24,7 +24,7 @@ double rounded(double metres) { return double(std::lround(metres * kPxPerM)); }
 // centre halfway between its black square's edges. mrcal's convention puts pixel centres at
 // integers, so a boundary drawn at x px lies at x - 0.5.
 Vec2 expected_pixel(const CalibrationBoard& board, int row, int col) {
-  if (board.kind == BoardKind::chessboard)
+  if (board.kind == BoardKind::chessboard || board.kind == BoardKind::charuco)
     return {rounded((col + 2) * board.spacing_m) - 0.5, rounded((row + 2) * board.spacing_m) - 0.5};
   const double margin = (board.spacing_m - board.tag_size_m) + board.tag_size_m / 8;  // gap + one white cell
   const auto centre = [&](int i) {
@@ -62,7 +62,7 @@ TEST_P(BoardPrintout, IsFoundWithEveryPointWhereTheBoardFileSays) {
 
 INSTANTIATE_TEST_SUITE_P(EveryBoardFile, BoardPrintout,
                          ::testing::Values("chessboard-10x14-20mm.toml", "chessboard-10x10-mrgingham.toml",
-                                           "aprilgrid-6x8-tag36h11.toml"));
+                                           "aprilgrid-6x8-tag36h11.toml", "charuco-10x14-20mm.toml"));
 
 TEST(BoardPrintoutErrors, AnImpossibleResolutionOrPathIsNamed) {
   const CalibrationBoard board =

@@ -1,0 +1,81 @@
+// ChArUco board files (configs/boards/charuco-*.toml): the shipped one loads as its comment says,
+// its points are OpenCV's ChArUco corners in mrcal's layout, and every mistake is named with the
+// file, the place and the key.
+#include <gtest/gtest.h>
+
+#include <opencv2/aruco/charuco.hpp>
+#include <string>
+
+#include "calib/calibration_board.h"
+#include "tests/calib/calib_test_support.h"
+
+namespace arpipe::calib {
+namespace {
+
+using namespace arpipe::calib::test;
+
+std::string error_of(const std::string& text) {
+  try {
+    parse_board(text, "b.toml");
+  } catch (const BoardError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+const std::string kCharuco = "kind = \"charuco\"\n";
+
+TEST(CharucoBoardFile, ShippedBoard) {
+  const CalibrationBoard board = load_board(fs::path(ARPIPE_SOURCE_DIR) / "configs/boards/charuco-10x14-20mm.toml");
+  EXPECT_EQ(board.kind, BoardKind::charuco);
+  EXPECT_EQ(board.rows, 9);
+  EXPECT_EQ(board.cols, 13);
+  EXPECT_DOUBLE_EQ(board.spacing_m, 0.02);
+  EXPECT_DOUBLE_EQ(board.marker_m, 0.015);
+  EXPECT_EQ(board.dictionary, "DICT_5X5_100");
+  EXPECT_EQ(board.dictionary_id, cv::aruco::DICT_5X5_100);
+}
+
+// OpenCV's ChArUco corner with id k lies at ((k % cols + 1) s, (k / cols + 1) s) from the board's
+// outer corner: the board file's point k, shifted by one square.
+TEST(CharucoBoardFile, PointsAreOpenCVsCornersInMrcalsLayout) {
+  const CalibrationBoard board = load_board(fs::path(ARPIPE_SOURCE_DIR) / "configs/boards/charuco-10x14-20mm.toml");
+  const auto charuco = cv::aruco::CharucoBoard::create(board.cols + 1, board.rows + 1, float(board.spacing_m),
+                                                       float(board.marker_m),
+                                                       cv::aruco::getPredefinedDictionary(board.dictionary_id));
+  const std::vector<Vec3> points = board.points();
+  ASSERT_EQ(charuco->chessboardCorners.size(), points.size());
+  for (size_t k = 0; k < points.size(); ++k) {
+    EXPECT_NEAR(charuco->chessboardCorners[k].x - board.spacing_m, points[k][0], 1e-7) << k;
+    EXPECT_NEAR(charuco->chessboardCorners[k].y - board.spacing_m, points[k][1], 1e-7) << k;
+  }
+}
+
+TEST(CharucoBoardFile, MistakesAreNamed) {
+  const std::string ok = "squares = [10, 14]\nsquare_m = 0.02\nmarker_m = 0.015\n";
+  EXPECT_EQ(error_of(kCharuco + ok + "dictionary = \"DICT_5X5_100\"\n"), "");
+  EXPECT_EQ(error_of(kCharuco + ok + "dictionary = \"DICT_9X9_1\"\n"),
+            "b.toml:5:14: dictionary: expected one of DICT_4X4_50, DICT_4X4_100, DICT_4X4_250, DICT_4X4_1000, "
+            "DICT_5X5_50, DICT_5X5_100, DICT_5X5_250, DICT_5X5_1000, DICT_6X6_50, DICT_6X6_100, DICT_6X6_250, "
+            "DICT_6X6_1000, DICT_7X7_50, DICT_7X7_100, DICT_7X7_250, DICT_7X7_1000, DICT_ARUCO_ORIGINAL, "
+            "DICT_APRILTAG_16h5, DICT_APRILTAG_25h9, DICT_APRILTAG_36h10, DICT_APRILTAG_36h11, found \"DICT_9X9_1\"");
+  EXPECT_NE(error_of(kCharuco + ok).find("b.toml:1:1: dictionary: expected one of DICT_4X4_50"), std::string::npos)
+      << error_of(kCharuco + ok);
+  // 140 squares hold 70 markers: DICT_5X5_50 has 50 codes.
+  EXPECT_EQ(error_of(kCharuco + ok + "dictionary = \"DICT_5X5_50\"\n"),
+            "b.toml:2:11: squares: expected at most 50 markers (DICT_5X5_50 has 50 codes; a board has one per light "
+            "square), found 10 x 14 squares, 70 markers");
+  EXPECT_EQ(error_of(kCharuco + "squares = [10, 14]\nsquare_m = 0.02\nmarker_m = 0.02\ndictionary = \"DICT_5X5_100\"\n"),
+            "b.toml:4:12: marker_m: expected less than square_m (0.02 m): the marker sits inside a light square, "
+            "found 0.02");
+  EXPECT_EQ(error_of(kCharuco + "squares = [2, 14]\nsquare_m = 0.02\nmarker_m = 0.015\ndictionary = \"DICT_5X5_100\"\n"),
+            "b.toml:2:11: squares: expected at least 3 squares each way (2 x 2 inner corners), found 2 x 14");
+  EXPECT_EQ(error_of(kCharuco + ok + "dictionary = \"DICT_5X5_100\"\ninner_corners = [9, 13]\n"),
+            "b.toml:6:1: inner_corners: unknown key; allowed keys in the top level: kind, description, squares, "
+            "square_m, marker_m, dictionary");
+  EXPECT_EQ(error_of(kCharuco + "squares = [10, 14]\nsquare_m = 0.02\nmarker_m = -1\ndictionary = \"DICT_5X5_100\"\n"),
+            "b.toml:4:12: marker_m: expected a number > 0 (m), found -1.0");
+}
+
+}  // namespace
+}  // namespace arpipe::calib
