@@ -4,7 +4,15 @@
 every corner and edge of the image, as mrcal's choreography asks (closeups, tilts up to ~45 degrees,
 the whole imager covered). Prints the [[trajectory.keyframe]] tables. Needs python3-mrcal.
 
+With --partial (configs/sim/calib-charuco.toml, a ChArUco board of the same size and place), the
+board may leave the image: a view counts the inner corners whose two light squares (the markers
+that name the corner) lie inside the image, large enough to read, needs at least --min-seen of them, and
+brings the nearest of them to its target; a quarter of the views aim at each image corner, closer
+up than a whole board could be there.
+
 Usage: scripts/design-calib-keyframes.py [--seed N] [--views N]
+       scripts/design-calib-keyframes.py --partial --seed 7 --views 36 --tries 1500 --margin 3 \
+           --min-square-px 18 --corner-distance 0.25 0.5 --distance 0.25 0.5
 """
 import argparse
 
@@ -44,6 +52,37 @@ def inside(q, margin):
     return np.all((q[:, 0] > margin) & (q[:, 0] < W - 1 - margin) & (q[:, 1] > margin) & (q[:, 1] < H - 1 - margin))
 
 
+# For --partial: the corners of the two light squares (the markers' squares) beside each inner
+# corner; the board's square (x, y), x along a row and y down the rows from the top left, is light
+# where x + y is odd, and spans world x from -0.14 + 0.02 x, y down from 0.10 - 0.02 y.
+def _light_squares(j, i):
+    out = []
+    for y in (j, j + 1):
+        for x in (i, i + 1):
+            if (x + y) % 2 == 1:
+                x0, y0 = -0.14 + 0.02 * x, 0.10 - 0.02 * y
+                out += [[x0, y0, 0.0], [x0 + 0.02, y0, 0.0], [x0 + 0.02, y0 - 0.02, 0.0], [x0, y0 - 0.02, 0.0]]
+    return out
+
+
+MARKER_SQUARES = np.array([_light_squares(j, i) for j in range(9) for i in range(13)])  # 117 x 8 x 3
+PARTIAL = {"on": False, "min_seen": 30, "margin": 4, "min_square_px": 0}
+
+
+def seen_corners(position, R):
+    """The inner corners whose two light squares lie inside the image (PARTIAL["margin"] px) and are
+    at least PARTIAL["min_square_px"] across, or None when the board is behind the camera."""
+    squares = project(MARKER_SQUARES.reshape(-1, 3), position, R)
+    corners = project(CORNERS, position, R)
+    if squares is None or corners is None:
+        return None
+    squares = squares.reshape(len(CORNERS), 8, 2)
+    edge = np.mean([np.linalg.norm(squares[:, k] - squares[:, k + 1 if k % 4 < 3 else k - 3], axis=1)
+                    for k in range(8)], axis=0)
+    ok = np.array([inside(q, PARTIAL["margin"]) for q in squares]) & (edge >= PARTIAL["min_square_px"])
+    return corners[ok]
+
+
 def random_view(rng, distances):
     look_at = np.array([rng.uniform(-0.3, 0.3), rng.uniform(-0.25, 0.25), 0.0])
     tilt = np.radians(rng.uniform(5, 45))
@@ -59,6 +98,11 @@ def score_view(position, look_at, roll, target):
     """How close the board's inner corners come to the target image point, or None when the
     board (white margin included) is not wholly inside the image."""
     R = camera_rotation(position, look_at, roll)
+    if PARTIAL["on"]:
+        seen = seen_corners(position, R)
+        if seen is None or len(seen) < PARTIAL["min_seen"]:
+            return None
+        return np.min(np.linalg.norm(seen - target, axis=1))
     outline = project(OUTLINE, position, R)
     if outline is None or not inside(outline, 2):
         return None
@@ -97,11 +141,23 @@ def main():
     parser.add_argument("--views", type=int, default=60)
     parser.add_argument("--tries", type=int, default=3000)
     parser.add_argument("--corner-distance", type=float, nargs=2, default=(0.5, 1.0))
+    parser.add_argument("--partial", action="store_true", help="views may show part of the board")
+    parser.add_argument("--min-seen", type=int, default=30, help="--partial: inner corners a view must show")
+    parser.add_argument("--margin", type=float, default=4, help="--partial: px between the image's edge and a seen corner's squares")
+    parser.add_argument("--min-square-px", type=float, default=0,
+                        help="--partial: a seen corner's squares at least this many px across (markers big enough to read)")
+    parser.add_argument("--distance", type=float, nargs=2, default=(0.32, 0.65), help="camera distance, other views")
     args = parser.parse_args()
+    PARTIAL["on"] = args.partial
+    PARTIAL["min_seen"] = args.min_seen
+    PARTIAL["margin"] = args.margin
+    PARTIAL["min_square_px"] = args.min_square_px
     rng = np.random.default_rng(args.seed)
     corners = [(0, 0), (W - 1, 0), (0, H - 1), (W - 1, H - 1)]
     edges = [(W / 2, 0), (W / 2, H - 1), (0, H / 2), (W - 1, H / 2)]
     targets = (corners * 3 + edges * 2 + [(W / 2, H / 2)] * 4) * max(1, args.views // 30)
+    if args.partial:
+        targets = corners * (args.views // 12) + edges * (args.views // 18) + [(W / 2, H / 2)] * (args.views // 18)
     while len(targets) < args.views:
         targets.append((rng.uniform(0, W - 1), rng.uniform(0, H - 1)))
     targets = targets[: args.views]
@@ -110,7 +166,7 @@ def main():
         # Close-ups pin the focal length and the distortion; in the image corners the whole board
         # (white margin included) only fits further away, where it is smaller, and the corners are
         # where a lens model is otherwise extrapolated.
-        distances = tuple(args.corner_distance) if targets[index] in corners else (0.32, 0.65)
+        distances = tuple(args.corner_distance) if targets[index] in corners else tuple(args.distance)
         score, position, look_at, roll = best_view(rng, np.array(targets[index], float), args.tries, distances)
         print(f"[[trajectory.keyframe]]  # reaches {score:.0f} px from image point "
               f"({targets[index][0]:.0f}, {targets[index][1]:.0f})")
