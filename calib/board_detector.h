@@ -1,7 +1,8 @@
 // Finds a calibration board in an 8-bit grey image: chessboards by a cascade of finders (mrgingham
 // on square N x N boards, OpenCV's findChessboardCornersSB with two sets of flags, then the classic
 // findChessboardCorners), the first that finds the whole board wins; AprilTag grids by
-// libapriltag, each tag's centre from the homography of its refined corners.
+// libapriltag, each tag's centre from the homography of its refined corners; ChArUco boards by
+// OpenCV's aruco module (the markers name the corners), each corner placed by the X-junction fit.
 #pragma once
 
 #include <memory>
@@ -68,7 +69,8 @@ class BoardDetector {
   std::optional<BoardObservation> detect(const unsigned char* grey, int width, int height, size_t stride,
                                          const std::string& image_name, const CameraModel& lens) const;
 
-  // The first method detect() tries for this board: "mrgingham", "findChessboardCornersSB", "apriltag".
+  // The first method detect() tries for this board: "mrgingham", "findChessboardCornersSB", "apriltag",
+  // "charuco".
   const std::string& method() const;
 
  private:
