@@ -118,7 +118,11 @@ DetectionSet detect_boards(const CalibrationImages& images, const CalibrationBoa
     throw CalibrationInputError(fmt::format(
         "the board ({} x {} points) was found in none of the {} images{}", board.rows, board.cols, total,
         board.kind == BoardKind::chessboard ? guess_other_chessboard(images, board)
-                                            : "; check the tag family, size and first id in the board file"));
+        : board.kind == BoardKind::charuco
+            ? fmt::format("; check the dictionary ({}) and the squares ({} x {}) in the board file, and that at least "
+                          "12 corners show",
+                          board.dictionary, board.rows + 1, board.cols + 1)
+            : "; check the tag family, size and first id in the board file"));
   return set;
 }
 

@@ -1,11 +1,16 @@
 // ChArUco board files (configs/boards/charuco-*.toml): the shipped one loads as its comment says,
-// its points are OpenCV's ChArUco corners in mrcal's layout, and every mistake is named with the
-// file, the place and the key.
+// its points are OpenCV's ChArUco corners in mrcal's layout, every mistake is named with the file,
+// the place and the key; and part of the printed board is a view with its corners named.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <opencv2/aruco/charuco.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <string>
 
+#include "calib/board_detector.h"
+#include "calib/board_printout.h"
 #include "calib/calibration_board.h"
 #include "tests/calib/calib_test_support.h"
 
@@ -75,6 +80,43 @@ TEST(CharucoBoardFile, MistakesAreNamed) {
             "square_m, marker_m, dictionary");
   EXPECT_EQ(error_of(kCharuco + "squares = [10, 14]\nsquare_m = 0.02\nmarker_m = -1\ndictionary = \"DICT_5X5_100\"\n"),
             "b.toml:4:12: marker_m: expected a number > 0 (m), found -1.0");
+}
+
+// Part of the printed board (its top-left corner, cut by the image's edge): the corners seen are
+// named by their markers and placed where they are drawn; a part with fewer than 12 corners is no
+// view (board_detector.cpp, kMinCharucoCorners). Drawn at 100 dpi, lightly blurred (a camera's
+// optics; the blur is symmetric about each corner, so it moves none).
+TEST(CharucoBoardDetection, PartOfTheBoardIsFoundWithItsCornersNamed) {
+  const CalibrationBoard board = load_board(fs::path(ARPIPE_SOURCE_DIR) / "configs/boards/charuco-10x14-20mm.toml");
+  const fs::path dir = scratch_dir("charuco-part");
+  constexpr double kPxPerM = 100 / 0.0254;
+  write_board_png(board, dir / "board.png", 100);
+  cv::Mat image = cv::imread((dir / "board.png").string(), cv::IMREAD_GRAYSCALE);
+  cv::GaussianBlur(image, image, cv::Size(0, 0), 1.0);
+  const auto rounded = [&](double metres) { return double(std::lround(metres * kPxPerM)); };
+  const BoardDetector detector(board);
+  // The margin and 6 x 5 squares: inner corners of rows 0-3, columns 0-4 (20), the outer ones
+  // with a marker cut in half.
+  for (const auto& [squares_x, squares_y, expect_view] : {std::tuple{6.5, 5.5, true}, std::tuple{3.5, 3.5, false}}) {
+    const cv::Mat part = image(cv::Rect(0, 0, int(rounded((1 + squares_x) * board.spacing_m)),
+                                        int(rounded((1 + squares_y) * board.spacing_m))))
+                             .clone();
+    const auto view = detector.detect(part.data, part.cols, part.rows, part.step, "part");
+    ASSERT_EQ(view.has_value(), expect_view) << squares_x << " x " << squares_y << " squares";
+    if (!view) continue;
+    EXPECT_GE(view->seen_count(), 12);
+    EXPECT_LT(view->seen_count(), board.point_count());
+    for (int r = 0; r < board.rows; ++r)
+      for (int c = 0; c < board.cols; ++c) {
+        const size_t i = size_t(r * board.cols + c);
+        if (view->weights[i] <= 0) continue;
+        EXPECT_LT(c, int(squares_x)) << "corner " << i << " is outside the part";
+        EXPECT_LT(r, int(squares_y)) << "corner " << i << " is outside the part";
+        EXPECT_NEAR(view->pixels[i][0], rounded((c + 2) * board.spacing_m) - 0.5, 0.1) << "corner " << i;
+        EXPECT_NEAR(view->pixels[i][1], rounded((r + 2) * board.spacing_m) - 0.5, 0.1) << "corner " << i;
+      }
+  }
+  remove_scratch(dir);
 }
 
 }  // namespace
