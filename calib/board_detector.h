@@ -58,8 +58,8 @@ class BoardDetector {
   // says which); cornerSubPix and the model fit refine each corner, and a corner neither can place
   // keeps the finder's place (BoardObservation::refined counts them). The points come in one canonical order: the board seen from its printed side (the
   // board frame right-handed with z away from the camera), rows running as nearly left to right
-  // in the image as the board's symmetry allows. A point that was not seen has weight -1 and
-  // pixel (-1, -1).
+  // in the image as the board's symmetry allows (ChArUco corners and AprilTag centres: by their
+  // ids, which fix the order). A point that was not seen has weight -1 and pixel (-1, -1).
   std::optional<BoardObservation> detect(const unsigned char* grey, int width, int height, size_t stride,
                                          const std::string& image_name) const;
   // The same with the lens known approximately, from a first solve. It matters for AprilTag grids
