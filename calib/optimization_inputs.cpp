@@ -239,24 +239,7 @@ std::string model_text_with_optimization_inputs(const CalibrationResult& result)
 }
 
 void save_model_with_optimization_inputs(const CalibrationResult& result, const std::filesystem::path& path) {
-  const std::string text = model_text_with_optimization_inputs(result);
-  const std::filesystem::path temporary = path.string() + ".tmp";
-  std::FILE* file = std::fopen(temporary.c_str(), "wb");
-  if (file == nullptr)
-    throw CameraModelError(fmt::format("{}: cannot write camera model: {}", path.string(), std::strerror(errno)));
-  const bool written = std::fwrite(text.data(), 1, text.size(), file) == text.size();
-  const int write_errno = errno;
-  if (std::fclose(file) != 0 || !written) {
-    std::filesystem::remove(temporary);
-    throw CameraModelError(fmt::format("{}: cannot write camera model: {}", path.string(),
-                                       std::strerror(written ? errno : write_errno)));
-  }
-  std::error_code ec;
-  std::filesystem::rename(temporary, path, ec);
-  if (ec) {
-    std::filesystem::remove(temporary);
-    throw CameraModelError(fmt::format("{}: cannot write camera model: {}", path.string(), ec.message()));
-  }
+  CameraModel::save_text(path, model_text_with_optimization_inputs(result));
 }
 
 }  // namespace arpipe::calib

@@ -469,10 +469,11 @@ std::string CameraModel::to_string() const {
   return out;
 }
 
-void CameraModel::save(const std::filesystem::path& path) const {
+void CameraModel::save(const std::filesystem::path& path) const { save_text(path, to_string()); }
+
+void CameraModel::save_text(const std::filesystem::path& path, const std::string& text) {
   // Write a temporary file and rename it, so a crash never leaves a half-written model behind.
   const std::filesystem::path temporary = path.string() + ".tmp";
-  const std::string text = to_string();
   std::FILE* file = std::fopen(temporary.c_str(), "wb");
   if (file == nullptr)
     throw CameraModelError(fmt::format("{}: cannot write camera model: {}", path.string(), std::strerror(errno)));

@@ -33,6 +33,9 @@ class CameraModel {
   static CameraModel parse(const std::string& text, const std::string& source_name);
   // Writes a .cameramodel at full precision (%.17g; mrcal's C writer rounds with %f), readable by mrcal.
   void save(const std::filesystem::path& path) const;
+  // Writes a model's text (to_string(), or one with more in it) as save() does: to a temporary
+  // file renamed into place, so a crash never leaves half a model. Throws CameraModelError.
+  static void save_text(const std::filesystem::path& path, const std::string& text);
   std::string to_string() const;
 
   const std::string& lensmodel() const { return lensmodel_; }

@@ -11,6 +11,7 @@
 #include <random>
 #include <sstream>
 
+#include "tests/support/printed_numbers.h"
 #include "calib/calibration_solver.h"
 #include "calib/corners_vnl.h"
 #include "calib/projection_uncertainty.h"
@@ -130,19 +131,7 @@ print("infinity", " ".join(repr(float(x)) for x in mrcal.projection_uncertainty(
 print("1m", " ".join(repr(float(x)) for x in mrcal.projection_uncertainty(v, m, what='worstdirection-stdev')))
 )";
 
-std::vector<double> numbers_after(const std::string& text, const std::string& key) {
-  std::istringstream lines(text);
-  for (std::string line; std::getline(lines, line);) {
-    std::istringstream words(line);
-    std::string first;
-    words >> first;
-    if (first != key) continue;
-    std::vector<double> out;
-    for (double x; words >> x;) out.push_back(x);
-    return out;
-  }
-  return {};
-}
+using arpipe::test::numbers_after;
 
 TEST(SolverUncertainty, AgreesWithMrcalCalibrateCameras) {
   if (!fs::exists("/usr/bin/mrcal-calibrate-cameras") || !fs::exists("/usr/bin/python3"))

@@ -14,6 +14,7 @@
 #include <set>
 #include <sstream>
 
+#include "tests/support/printed_numbers.h"
 #include "core/geometry/camera_model.h"
 #include "tests/e2e/child_process.h"
 
@@ -46,19 +47,7 @@ u = mrcal.projection_uncertainty(v, m, atinfinity=True, what='worstdirection-std
 print("uncertainty", " ".join(repr(float(x)) for x in u))
 )";
 
-std::vector<double> numbers_after(const std::string& text, const std::string& key) {
-  std::istringstream lines(text);
-  for (std::string line; std::getline(lines, line);) {
-    std::istringstream words(line);
-    std::string first;
-    words >> first;
-    if (first != key) continue;
-    std::vector<double> out;
-    for (double x; words >> x;) out.push_back(x);
-    return out;
-  }
-  return {};
-}
+using arpipe::test::numbers_after;
 
 // Runs a shell command in dir; returns its exit status (-1 when it did not exit normally).
 int shell(const fs::path& dir, const std::string& command) {

@@ -29,21 +29,6 @@ using namespace arpipe::sim::test;
 
 constexpr double kPi = 3.14159265358979323846;
 
-std::vector<uint8_t> file_bytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-std::string error_of(const std::string& text) {
-  try {
-    parse_sim_scene(text, "scene.toml", {});
-  } catch (const SceneError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "no SceneError for:\n" << text;
-  return "";
-}
-
 // The fraction of a disc of radius r lying at x > -s (its edge-spread function).
 double disc_esf(double s, double r) {
   if (s <= -r) return 0;

@@ -5,19 +5,12 @@
 #include <string>
 
 #include "capture/sim/sim_scene_loader.h"
+#include "tests/sim/sim_test_support.h"
 
 namespace arpipe::sim {
 namespace {
 
-std::string error_of(const std::string& text) {
-  try {
-    parse_sim_scene(text, "scene.toml", {});
-  } catch (const SceneError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "no SceneError for:\n" << text;
-  return "";
-}
+using namespace arpipe::sim::test;
 
 TEST(SimSceneBayer, BayerFormatAndBlackLevelLoad) {
   const SimScene scene = parse_sim_scene("[camera]\npixel_format = \"SBGGR12P\"\n[camera.sensor]\nblack_level = 256\n",

@@ -134,7 +134,7 @@ const char* kTriangleGltf = R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"
 // ---- The example scenes --------------------------------------------------------------------------
 
 TEST(SimSceneLoaderExamples, EveryExampleLoadsAndSaysWhatItIsFor) {
-  const std::set<std::string> expected{"blur-bench.toml", "calib-board.toml", "calib-board-photo.toml", "default.toml", "probe-indoor.toml", "rolling-shutter.toml",
+  const std::set<std::string> expected{"blur-bench.toml", "calib-board.toml", "calib-board-photo.toml", "calib-charuco.toml", "default.toml", "probe-indoor.toml", "rolling-shutter.toml",
                                        "proxies.toml", "proxies-panorama.toml", "courtyard.toml", "sun-outdoor.toml",
                                        "tag-pan.toml", "tag-static.toml"};
   std::set<std::string> found;
@@ -167,7 +167,8 @@ TEST(SimSceneLoaderExamples, EveryExampleLoadsAndSaysWhatItIsFor) {
     EXPECT_EQ(scene.camera.model.width(), 640);
     EXPECT_EQ(scene.camera.model.height(), 480);
     const bool calibration =
-        entry.path().filename() == "calib-board.toml" || entry.path().filename() == "calib-board-photo.toml";
+        entry.path().filename() == "calib-board.toml" || entry.path().filename() == "calib-board-photo.toml" ||
+        entry.path().filename() == "calib-charuco.toml";
     EXPECT_EQ(scene.camera.model.lensmodel(), calibration ? "LENSMODEL_OPENCV8" : "LENSMODEL_OPENCV4");
     EXPECT_EQ(scene.camera.model.fx(), 520.0);
   }

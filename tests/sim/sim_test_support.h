@@ -8,16 +8,35 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
 #include <vector>
 
 #include "capture/sim/sim_scene.h"
+#include "capture/sim/sim_scene_loader.h"
 
 namespace arpipe::sim::test {
 
 namespace fs = std::filesystem;
+
+inline std::vector<uint8_t> file_bytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// The SceneError a scene text (as "scene.toml") gives; a test failure when it gives none.
+inline std::string error_of(const std::string& text) {
+  try {
+    parse_sim_scene(text, "scene.toml", {});
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no SceneError for:\n" << text;
+  return "";
+}
 
 inline fs::path scratch_dir(const std::string& name) {
   const fs::path dir = fs::temp_directory_path() / fmt::format("arpipe-sim-test-{}-{}", getpid(), name);

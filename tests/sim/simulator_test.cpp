@@ -24,11 +24,6 @@ using namespace arpipe::sim::test;
 
 constexpr double kPi = 3.14159265358979323846;
 
-std::vector<uint8_t> file_bytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
 cv::Mat grey_frame(const RecordingReader& reader, size_t index) {
   Frame frame;
   reader.read(index, frame);
