@@ -15,16 +15,6 @@ using namespace arpipe::calib::test;
 
 const fs::path kBoards = fs::path(ARPIPE_SOURCE_DIR) / "configs" / "boards";
 
-// The message parse_board throws for `text` (named "b.toml"), or "" when it parses.
-std::string error_of(const std::string& text) {
-  try {
-    parse_board(text, "b.toml");
-  } catch (const BoardError& e) {
-    return e.what();
-  }
-  return "";
-}
-
 const std::string kChess = "kind = \"chessboard\"\n";
 const std::string kGrid = "kind = \"apriltag_grid\"\n";
 
@@ -88,74 +78,74 @@ TEST(BoardFile, AprilGridDefaultsAndPitch) {
 }
 
 TEST(BoardFile, UnknownKeyIsNamedWithItsPlace) {
-  EXPECT_EQ(error_of(kChess + "inner_corners = [9, 13]\nsquare_m = 0.02\ncolour = \"red\"\n"),
+  EXPECT_EQ(board_error_of(kChess + "inner_corners = [9, 13]\nsquare_m = 0.02\ncolour = \"red\"\n"),
             "b.toml:4:1: colour: unknown key; allowed keys in the top level: kind, description, inner_corners, square_m");
-  EXPECT_EQ(error_of(kChess + "tags = [3, 4]\n"),
+  EXPECT_EQ(board_error_of(kChess + "tags = [3, 4]\n"),
             "b.toml:2:1: tags: unknown key; allowed keys in the top level: kind, description, inner_corners, "
             "square_m");
-  EXPECT_EQ(error_of(kGrid + "tags = [3, 4]\ntag_size_m = 0.04\ntag_spacing_m = 0.01\nsquare_m = 0.02\n"),
+  EXPECT_EQ(board_error_of(kGrid + "tags = [3, 4]\ntag_size_m = 0.04\ntag_spacing_m = 0.01\nsquare_m = 0.02\n"),
             "b.toml:5:1: square_m: unknown key; allowed keys in the top level: kind, description, tags, tag_size_m, "
             "tag_spacing_m, family, first_id");
 }
 
 TEST(BoardFile, WrongTypesAreNamed) {
-  EXPECT_EQ(error_of(kChess + "inner_corners = [9, 13]\nsquare_m = \"20mm\"\n"),
+  EXPECT_EQ(board_error_of(kChess + "inner_corners = [9, 13]\nsquare_m = \"20mm\"\n"),
             "b.toml:3:12: square_m: expected a number > 0 (m), found a string");
-  EXPECT_EQ(error_of(kChess + "inner_corners = \"9x13\"\nsquare_m = 0.02\n"),
+  EXPECT_EQ(board_error_of(kChess + "inner_corners = \"9x13\"\nsquare_m = 0.02\n"),
             "b.toml:2:17: inner_corners: expected [rows, cols] of inner corners (squares - 1 each way), two "
             "integers >= 2, found a string");
-  EXPECT_EQ(error_of(kChess + "inner_corners = [9, 13.0]\nsquare_m = 0.02\n"),
+  EXPECT_EQ(board_error_of(kChess + "inner_corners = [9, 13.0]\nsquare_m = 0.02\n"),
             "b.toml:2:21: inner_corners[1]: expected an integer in [2, 1000], found a float");
-  EXPECT_EQ(error_of("kind = 1\n"), "b.toml:1:8: kind: expected one of \"chessboard\", \"apriltag_grid\", \"charuco\", found an integer");
-  EXPECT_EQ(error_of(kGrid + "tags = [3, 4]\ntag_size_m = 0.04\ntag_spacing_m = 0.01\nfirst_id = 1.5\n"),
+  EXPECT_EQ(board_error_of("kind = 1\n"), "b.toml:1:8: kind: expected one of \"chessboard\", \"apriltag_grid\", \"charuco\", found an integer");
+  EXPECT_EQ(board_error_of(kGrid + "tags = [3, 4]\ntag_size_m = 0.04\ntag_spacing_m = 0.01\nfirst_id = 1.5\n"),
             "b.toml:5:12: first_id: expected an integer in [0, 575], found a float");
-  EXPECT_EQ(error_of(kChess + "inner_corners = [9, 13]\nsquare_m = 0.02\ndescription = 3\n"),
+  EXPECT_EQ(board_error_of(kChess + "inner_corners = [9, 13]\nsquare_m = 0.02\ndescription = 3\n"),
             "b.toml:4:15: description: expected a string, found an integer");
 }
 
 TEST(BoardFile, MissingKeysAreNamed) {
-  EXPECT_EQ(error_of("inner_corners = [9, 13]\nsquare_m = 0.02\n"),
+  EXPECT_EQ(board_error_of("inner_corners = [9, 13]\nsquare_m = 0.02\n"),
             "b.toml:1:1: kind: expected one of \"chessboard\", \"apriltag_grid\", \"charuco\", found nothing");
-  EXPECT_EQ(error_of(kChess + "inner_corners = [9, 13]\n"),
+  EXPECT_EQ(board_error_of(kChess + "inner_corners = [9, 13]\n"),
             "b.toml:1:1: square_m: expected a number > 0 (m), found nothing");
-  EXPECT_EQ(error_of(kChess + "square_m = 0.02\n"),
+  EXPECT_EQ(board_error_of(kChess + "square_m = 0.02\n"),
             "b.toml:1:1: inner_corners: expected [rows, cols] of inner corners (squares - 1 each way), two "
             "integers >= 2, found nothing");
-  EXPECT_EQ(error_of(kGrid + "tags = [3, 4]\ntag_size_m = 0.04\n"),
+  EXPECT_EQ(board_error_of(kGrid + "tags = [3, 4]\ntag_size_m = 0.04\n"),
             "b.toml:1:1: tag_spacing_m: expected a number >= 0 (m), found nothing");
 }
 
 TEST(BoardFile, BadValuesAreNamed) {
-  EXPECT_EQ(error_of("kind = \"circles\"\n"), "b.toml:1:8: kind: expected one of \"chessboard\", \"apriltag_grid\", \"charuco\", found \"circles\"");
-  EXPECT_EQ(error_of(kChess + "inner_corners = [1, 13]\nsquare_m = 0.02\n"),
+  EXPECT_EQ(board_error_of("kind = \"circles\"\n"), "b.toml:1:8: kind: expected one of \"chessboard\", \"apriltag_grid\", \"charuco\", found \"circles\"");
+  EXPECT_EQ(board_error_of(kChess + "inner_corners = [1, 13]\nsquare_m = 0.02\n"),
             "b.toml:2:18: inner_corners[0]: expected an integer in [2, 1000], found 1");
-  EXPECT_EQ(error_of(kChess + "inner_corners = [9, 13, 2]\nsquare_m = 0.02\n"),
+  EXPECT_EQ(board_error_of(kChess + "inner_corners = [9, 13, 2]\nsquare_m = 0.02\n"),
             "b.toml:2:17: inner_corners: expected [rows, cols] of inner corners (squares - 1 each way), two integers "
             ">= 2, found 3 items");
-  EXPECT_EQ(error_of(kChess + "inner_corners = [40, 40]\nsquare_m = 0.02\n"),
+  EXPECT_EQ(board_error_of(kChess + "inner_corners = [40, 40]\nsquare_m = 0.02\n"),
             "b.toml:2:17: inner_corners: expected at most 1000 points, found 40 x 40");
-  EXPECT_EQ(error_of(kChess + "inner_corners = [9, 13]\nsquare_m = 0\n"),
+  EXPECT_EQ(board_error_of(kChess + "inner_corners = [9, 13]\nsquare_m = 0\n"),
             "b.toml:3:12: square_m: expected a number > 0 (m), found 0.0");
-  EXPECT_EQ(error_of(kChess + "inner_corners = [9, 13]\nsquare_m = -0.02\n"),
+  EXPECT_EQ(board_error_of(kChess + "inner_corners = [9, 13]\nsquare_m = -0.02\n"),
             "b.toml:3:12: square_m: expected a number > 0 (m), found -0.02");
-  EXPECT_EQ(error_of(kChess + "inner_corners = [9, 13]\nsquare_m = nan\n"),
+  EXPECT_EQ(board_error_of(kChess + "inner_corners = [9, 13]\nsquare_m = nan\n"),
             "b.toml:3:12: square_m: expected a finite number, found nan");
-  EXPECT_EQ(error_of(kGrid + "tags = [3, 4]\ntag_size_m = 0.04\ntag_spacing_m = 0.01\nfamily = \"tag99\"\n"),
+  EXPECT_EQ(board_error_of(kGrid + "tags = [3, 4]\ntag_size_m = 0.04\ntag_spacing_m = 0.01\nfamily = \"tag99\"\n"),
             "b.toml:5:10: family: expected one of tag16h5, tag25h9, tag36h10, tag36h11, tagCircle21h7, "
             "tagCircle49h12, tagCustom48h12, tagStandard41h12, tagStandard52h13, found \"tag99\"");
   // tag36h11: 10 cells printed, 8 to the black border, so neighbours need a 2-cell (0.25 x tag) gap.
-  EXPECT_EQ(error_of(kGrid + "tags = [3, 4]\ntag_size_m = 0.04\ntag_spacing_m = 0.009\n"),
+  EXPECT_EQ(board_error_of(kGrid + "tags = [3, 4]\ntag_size_m = 0.04\ntag_spacing_m = 0.009\n"),
             "b.toml:4:17: tag_spacing_m: expected a gap of at least 0.01 m (2 cells of a tag36h11 tag of 0.04 m, so "
             "that printed tags do not overlap), found 0.009");
-  EXPECT_EQ(error_of(kGrid + "tags = [3, 4]\ntag_size_m = 0.04\ntag_spacing_m = 0.01\nfirst_id = 576\n"),
+  EXPECT_EQ(board_error_of(kGrid + "tags = [3, 4]\ntag_size_m = 0.04\ntag_spacing_m = 0.01\nfirst_id = 576\n"),
             "b.toml:5:12: first_id: expected an integer in [0, 575], found 576");  // 576 + 12 > 587 ids
-  EXPECT_EQ(error_of(kGrid + "tags = [6, 6]\ntag_size_m = 0.04\ntag_spacing_m = 0.02\nfamily = \"tag16h5\"\n"),
+  EXPECT_EQ(board_error_of(kGrid + "tags = [6, 6]\ntag_size_m = 0.04\ntag_spacing_m = 0.02\nfamily = \"tag16h5\"\n"),
             "b.toml:2:8: tags: expected at most 30 tags (family tag16h5 has 30 ids), found 6 x 6");
 }
 
 TEST(BoardFile, SyntaxErrorAndUnreadableFile) {
-  EXPECT_EQ(error_of(kChess + "square_m = \n").rfind("b.toml:2:", 0), 0u) << error_of(kChess + "square_m = \n");
-  EXPECT_NE(error_of(kChess + "square_m = \n").find("TOML syntax error"), std::string::npos);
+  EXPECT_EQ(board_error_of(kChess + "square_m = \n").rfind("b.toml:2:", 0), 0u) << board_error_of(kChess + "square_m = \n");
+  EXPECT_NE(board_error_of(kChess + "square_m = \n").find("TOML syntax error"), std::string::npos);
 
   const fs::path dir = scratch_dir("board-file");
   try {

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "calib/board_observation.h"
+#include "calib/calibration_board.h"
 #include "calib/calibration_images.h"
 #include "capture/recording/recording_reader.h"
 #include "capture/sim/sim_scene_loader.h"
@@ -100,6 +101,16 @@ inline std::vector<Vec2> in_detector_order(const std::vector<Vec2>& truth, int c
   for (size_t i = 0; i + 1 < truth.size(); ++i)
     if ((i + 1) % cols != 0) dx += truth[i + 1][0] - truth[i][0];
   return dx >= 0 ? truth : turned(truth);
+}
+
+// The message parse_board throws for `text` (named "b.toml"), or "" when it parses.
+inline std::string board_error_of(const std::string& text) {
+  try {
+    parse_board(text, "b.toml");
+  } catch (const BoardError& e) {
+    return e.what();
+  }
+  return "";
 }
 
 struct CornerErrors {

@@ -19,15 +19,6 @@ namespace {
 
 using namespace arpipe::calib::test;
 
-std::string error_of(const std::string& text) {
-  try {
-    parse_board(text, "b.toml");
-  } catch (const BoardError& e) {
-    return e.what();
-  }
-  return "";
-}
-
 const std::string kCharuco = "kind = \"charuco\"\n";
 
 TEST(CharucoBoardFile, ShippedBoard) {
@@ -58,27 +49,27 @@ TEST(CharucoBoardFile, PointsAreOpenCVsCornersInMrcalsLayout) {
 
 TEST(CharucoBoardFile, MistakesAreNamed) {
   const std::string ok = "squares = [10, 14]\nsquare_m = 0.02\nmarker_m = 0.015\n";
-  EXPECT_EQ(error_of(kCharuco + ok + "dictionary = \"DICT_5X5_100\"\n"), "");
-  EXPECT_EQ(error_of(kCharuco + ok + "dictionary = \"DICT_9X9_1\"\n"),
+  EXPECT_EQ(board_error_of(kCharuco + ok + "dictionary = \"DICT_5X5_100\"\n"), "");
+  EXPECT_EQ(board_error_of(kCharuco + ok + "dictionary = \"DICT_9X9_1\"\n"),
             "b.toml:5:14: dictionary: expected one of DICT_4X4_50, DICT_4X4_100, DICT_4X4_250, DICT_4X4_1000, "
             "DICT_5X5_50, DICT_5X5_100, DICT_5X5_250, DICT_5X5_1000, DICT_6X6_50, DICT_6X6_100, DICT_6X6_250, "
             "DICT_6X6_1000, DICT_7X7_50, DICT_7X7_100, DICT_7X7_250, DICT_7X7_1000, DICT_ARUCO_ORIGINAL, "
             "DICT_APRILTAG_16h5, DICT_APRILTAG_25h9, DICT_APRILTAG_36h10, DICT_APRILTAG_36h11, found \"DICT_9X9_1\"");
-  EXPECT_NE(error_of(kCharuco + ok).find("b.toml:1:1: dictionary: expected one of DICT_4X4_50"), std::string::npos)
-      << error_of(kCharuco + ok);
+  EXPECT_NE(board_error_of(kCharuco + ok).find("b.toml:1:1: dictionary: expected one of DICT_4X4_50"), std::string::npos)
+      << board_error_of(kCharuco + ok);
   // 140 squares hold 70 markers: DICT_5X5_50 has 50 codes.
-  EXPECT_EQ(error_of(kCharuco + ok + "dictionary = \"DICT_5X5_50\"\n"),
+  EXPECT_EQ(board_error_of(kCharuco + ok + "dictionary = \"DICT_5X5_50\"\n"),
             "b.toml:2:11: squares: expected at most 50 markers (DICT_5X5_50 has 50 codes; a board has one per light "
             "square), found 10 x 14 squares, 70 markers");
-  EXPECT_EQ(error_of(kCharuco + "squares = [10, 14]\nsquare_m = 0.02\nmarker_m = 0.02\ndictionary = \"DICT_5X5_100\"\n"),
+  EXPECT_EQ(board_error_of(kCharuco + "squares = [10, 14]\nsquare_m = 0.02\nmarker_m = 0.02\ndictionary = \"DICT_5X5_100\"\n"),
             "b.toml:4:12: marker_m: expected less than square_m (0.02 m): the marker sits inside a light square, "
             "found 0.02");
-  EXPECT_EQ(error_of(kCharuco + "squares = [2, 14]\nsquare_m = 0.02\nmarker_m = 0.015\ndictionary = \"DICT_5X5_100\"\n"),
+  EXPECT_EQ(board_error_of(kCharuco + "squares = [2, 14]\nsquare_m = 0.02\nmarker_m = 0.015\ndictionary = \"DICT_5X5_100\"\n"),
             "b.toml:2:11: squares: expected at least 3 squares each way (2 x 2 inner corners), found 2 x 14");
-  EXPECT_EQ(error_of(kCharuco + ok + "dictionary = \"DICT_5X5_100\"\ninner_corners = [9, 13]\n"),
+  EXPECT_EQ(board_error_of(kCharuco + ok + "dictionary = \"DICT_5X5_100\"\ninner_corners = [9, 13]\n"),
             "b.toml:6:1: inner_corners: unknown key; allowed keys in the top level: kind, description, squares, "
             "square_m, marker_m, dictionary");
-  EXPECT_EQ(error_of(kCharuco + "squares = [10, 14]\nsquare_m = 0.02\nmarker_m = -1\ndictionary = \"DICT_5X5_100\"\n"),
+  EXPECT_EQ(board_error_of(kCharuco + "squares = [10, 14]\nsquare_m = 0.02\nmarker_m = -1\ndictionary = \"DICT_5X5_100\"\n"),
             "b.toml:4:12: marker_m: expected a number > 0 (m), found -1.0");
 }
 
