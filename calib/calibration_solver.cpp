@@ -403,7 +403,7 @@ CalibrationResult solve_calibration(const CalibrationBoard& board, const std::ve
   s.do_optimize_intrinsics_core = !splined;
   s.do_optimize_intrinsics_distortions = has_distortions;
   s.do_optimize_extrinsics = true;  // no extrinsics here (one camera); set as mrcal-calibrate-cameras does
-  s.do_apply_regularization = true;
+  s.do_apply_regularization = options.regularize;
   s.do_apply_outlier_rejection = options.reject_outliers;
   run("full model", s);
 

@@ -29,6 +29,12 @@ struct SolveOptions {
   double focal_guess_px = 0;      // 0: guess from the views (PnP over candidate focal lengths)
   bool optimize_board_warp = true;
   bool reject_outliers = true;
+  // mrcal's regularisation (distortions toward 0, the centre toward the image's middle). Its weight
+  // is fixed for corners about 1 px off (mrcal 2.2, mrcal.c: normal_pixel_error = 1.0), not scaled
+  // by the actual noise, so it biases the lens by a constant few thousandths of a pixel: nothing
+  // against real corners (0.01-0.3 px), the floor of a synthetic solve at 0.001 px. Off only for
+  // such studies (`arpipe bench calib-solve --no-regularization`); a real calibration keeps it.
+  bool regularize = true;
   bool verbose = false;           // mrcal's solver prints its progress to stderr
 };
 
