@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstring>
 #include <exception>
+#include <filesystem>
 #include <memory>
 #include <new>
 #include <stdexcept>
@@ -68,6 +69,9 @@ int run_simulate(SimulateOptions& command) {
         std::erase_if(exported.objects, named);
       }
       const std::vector<uint8_t> glb = sim::export_scene_glb(exported);
+      // Its folder is made as --out's is (the usual place is inside --out, not written yet).
+      const std::filesystem::path parent = std::filesystem::path(command.export_glb).parent_path();
+      if (!parent.empty()) std::filesystem::create_directories(parent);
       if (const int error = replace_file(command.export_glb, glb))
         throw std::runtime_error(fmt::format("{}: {}", command.export_glb, std::strerror(error)));
       log::info("wrote the real objects and {} lights to {}", scene.lights.size(), command.export_glb);
