@@ -3,6 +3,7 @@
 #include "calib/board_detector.h"
 
 #include "calib/chessboard_corner_fit.h"
+#include "calib/grid_consistency.h"
 
 #include <fmt/format.h>
 #include <mrgingham/mrgingham.hh>
@@ -209,9 +210,12 @@ struct RefineReach {
 // keeps its place from before that step. Points with weight <= 0 (not seen) are left alone and are
 // nobody's neighbour; a corner with no seen neighbour takes its `fallback_spacing` (px, one per
 // point; none given: such a corner is dropped) as that distance, and the model fit needs a seen neighbour along its row and along its column.
+// check_grid: then drops the refined corners that lie off their neighbours' homography
+// (grid_consistency.h), for a finder that does not check its grid itself.
 BoardObservation::Refinements refine_corners(const cv::Mat& image, CornerRefinement refinement, Grid& grid,
                                              const RefineReach& reach = {},
-                                             const std::vector<double>& fallback_spacing = {}) {
+                                             const std::vector<double>& fallback_spacing = {},
+                                             bool check_grid = false) {
   BoardObservation::Refinements counts;
   if (refinement == CornerRefinement::none) {
     for (double w : grid.weights) counts.detector += w > 0;
@@ -219,6 +223,7 @@ BoardObservation::Refinements refine_corners(const cv::Mat& image, CornerRefinem
   }
   const cv::TermCriteria stop(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50, 0.001);
   const Grid found = grid;
+  std::vector<int*> placed(grid.px.size(), nullptr);  // which count each corner went to
   const auto seen = [&found](int r, int c) {
     return r >= 0 && r < found.rows && c >= 0 && c < found.cols && found.weights[size_t(r * found.cols + c)] > 0;
   };
@@ -283,8 +288,18 @@ BoardObservation::Refinements refine_corners(const cv::Mat& image, CornerRefinem
         continue;
       }
       ++*placed_by;
+      placed[static_cast<size_t>(r * grid.cols + c)] = placed_by;
       grid.px[static_cast<size_t>(r * grid.cols + c)] = refined;
     }
+  if (check_grid) {
+    const std::vector<double> before = grid.weights;
+    drop_off_grid_corners(grid.rows, grid.cols, grid.px, grid.weights);
+    for (size_t i = 0; i < before.size(); ++i)
+      if (before[i] > 0 && grid.weights[i] <= 0 && placed[i] != nullptr) {
+        --*placed[i];
+        ++counts.dropped;
+      }
+  }
   return counts;
 }
 
@@ -382,13 +397,14 @@ struct BoardDetector::Impl {
   cv::Ptr<cv::aruco::CharucoBoard> charuco;
   cv::Ptr<cv::aruco::DetectorParameters> aruco_parameters;
   std::optional<BoardObservation> detect_charuco(const cv::Mat& image) const;
-  // Refines the corners and puts them in the canonical order.
-  std::optional<BoardObservation> observation(Grid grid, const cv::Mat& image, const std::string& detector) const;
+  // Refines the corners (check_grid: see refine_corners) and puts them in the canonical order.
+  std::optional<BoardObservation> observation(Grid grid, const cv::Mat& image, const std::string& detector,
+                                              bool check_grid = false) const;
 };
 
 std::optional<BoardObservation> BoardDetector::Impl::observation(Grid grid, const cv::Mat& image,
-                                                                 const std::string& detector) const {
-  const BoardObservation::Refinements refined = refine_corners(image, refinement, grid);
+                                                                 const std::string& detector, bool check_grid) const {
+  const BoardObservation::Refinements refined = refine_corners(image, refinement, grid, {}, {}, check_grid);
   grid = canonical_order(grid);
   for (size_t i = 0; i < grid.px.size(); ++i)
     if (grid.weights[i] <= 0) grid.px[i] = kUnseen;
@@ -434,7 +450,8 @@ std::optional<BoardObservation> BoardDetector::Impl::from_corners(const std::vec
     grid.px.push_back({p.x, p.y});
     grid.weights.push_back(1.0);
   }
-  return observation(std::move(grid), image, chessboard_finder_name(finder));
+  // The classic finder can put a corner on the wrong junction (glare), and nothing checks it there.
+  return observation(std::move(grid), image, chessboard_finder_name(finder), finder == ChessboardFinder::classic);
 }
 
 std::optional<BoardObservation> BoardDetector::Impl::detect_sb(const cv::Mat& image, int flags,

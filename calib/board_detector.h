@@ -55,8 +55,10 @@ class BoardDetector {
   // grey: width x height bytes, rows `stride` apart. Never throws. Safe to call from one thread at
   // a time per detector (make one detector per thread).
   // Chessboards: the finders in order until one finds the whole board (BoardObservation::detector
-  // says which); cornerSubPix and the model fit refine each corner, and a corner neither can place
-  // keeps the finder's place (BoardObservation::refined counts them). The points come in one canonical order: the board seen from its printed side (the
+  // says which); cornerSubPix and the model fit refine each corner (a corner cornerSubPix cannot
+  // place is dropped, one the fit cannot place keeps cornerSubPix's), and on the classic finder's
+  // boards a corner off its neighbours' homography is dropped (grid_consistency.h);
+  // BoardObservation::refined counts them. The points come in one canonical order: the board seen from its printed side (the
   // board frame right-handed with z away from the camera), rows running as nearly left to right
   // in the image as the board's symmetry allows (ChArUco corners and AprilTag centres: by their
   // ids, which fix the order). A point that was not seen has weight -1 and pixel (-1, -1).
