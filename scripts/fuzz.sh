@@ -14,8 +14,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-all_targets=(fuzz_gltf fuzz_config fuzz_sim_scene fuzz_board fuzz_recording fuzz_radiance_hdr fuzz_openexr
-             fuzz_png_jpeg fuzz_cameramodel fuzz_prt_cache)
+# Every target of tests/fuzz/CMakeLists.txt, read from there so that a new one is never missed here.
+mapfile -t all_targets < <(sed -n 's/^arpipe_fuzz_target(\(fuzz_[a-z_]*\).*/\1/p' tests/fuzz/CMakeLists.txt)
 # Seeds beyond the target's own tests/fuzz/corpus/<target>/, one line per target (shared with the
 # ctest runs in tests/fuzz/CMakeLists.txt); libFuzzer reads corpus folders recursively.
 declare -A extra_seeds=()

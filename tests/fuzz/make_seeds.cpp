@@ -11,9 +11,12 @@
 #include <filesystem>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <string>
 #include <vector>
 
+#include "calib/board_printout.h"
+#include "calib/calibration_board.h"
 #include "capture/recording/recording_writer.h"
 #include "core/config/config.h"
 #include "core/frame.h"
@@ -21,6 +24,7 @@
 #include "core/image/openexr_file.h"
 #include "core/image/radiance_hdr.h"
 #include "render/prt/prt_cache.h"
+#include "tests/fuzz/fuzz_boards.h"
 #include "tests/scene/gltf_test_files.h"
 
 namespace fs = std::filesystem;
@@ -222,6 +226,25 @@ void config_seeds() {
 
 }  // namespace
 
+// fuzz_board_detection: each of its boards drawn by `arpipe board`'s writer, shrunk to 96 pixels
+// across with a 12-pixel white border, in the target's input format (board, width - 8, height - 8, detect through a lens
+// too, grey pixels).
+void board_detection_seeds(const fs::path& scratch) {
+  for (size_t which = 0; which < std::size(fuzz::kDetectionBoards); ++which) {
+    const calib::CalibrationBoard board = calib::parse_board(fuzz::kDetectionBoards[which], "seed.toml");
+    const fs::path png = scratch / ("board-" + std::to_string(which) + ".png");
+    calib::write_board_png(board, png, 100);
+    const cv::Mat drawn = cv::imread(png.string(), cv::IMREAD_GRAYSCALE);
+    const double scale = 96.0 / std::max(drawn.cols, drawn.rows);
+    cv::Mat shrunk, small;
+    cv::resize(drawn, shrunk, cv::Size(), scale, scale, cv::INTER_AREA);
+    cv::copyMakeBorder(shrunk, small, 12, 12, 12, 12, cv::BORDER_CONSTANT, cv::Scalar(255));  // a quiet zone
+    std::string bytes{char(which), char(small.cols - 8), char(small.rows - 8), char(1)};
+    for (int y = 0; y < small.rows; ++y) bytes.append(small.ptr<char>(y), size_t(small.cols));
+    write("fuzz_board_detection", "board-" + std::to_string(which), bytes);
+  }
+}
+
 int main(int argc, char** argv) {
   if (argc != 2) {
     std::fprintf(stderr, "usage: fuzz_make_seeds OUT_DIR\n");
@@ -238,6 +261,7 @@ int main(int argc, char** argv) {
   recording_seeds(scratch);
   prt_seeds(scratch);
   config_seeds();
+  board_detection_seeds(scratch);
   fs::remove_all(scratch);
   return 0;
 }
