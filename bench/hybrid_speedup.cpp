@@ -1,5 +1,7 @@
 // Benchmark: seed 003's protocol, the hybrid viewer against the full 3D scene. `arpipe bench hybrid
-// [--scene FILE] [--config FILE] [--frames N] [--truth-views K] [--work DIR] ...`
+// [--scene FILE] [--config FILE] [--frames N] [--truth-views K] [--work DIR] [--viewpoint X,Y,Z]... ...`
+// (the seed repeats its protocol at each viewpoint: each --viewpoint gets its own panorama and
+// table, then a summary of the speedups)
 //
 // From a simulator scene (configs/sim/courtyard.toml: its real objects, lights, sky and virtual
 // objects; the camera an equirectangular one at the viewpoint) and the hybrid's config
@@ -25,6 +27,7 @@
 #include <filesystem>
 #include <memory>
 #include <numbers>
+#include <optional>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -69,7 +72,30 @@ struct Options {
   int video_frames = 30;    // the video's length (it loops)
   int video_samples = 4;    // rays a pixel of each video frame
   double ratio = 10;        // the simplified proxies' triangle ratio
+  // The viewpoints ("teleport points", each measured as the seed measured its own), as "x,y,z" in
+  // metres; empty: the config's source.panorama.position_m alone.
+  std::vector<std::string> viewpoints;
 };
+
+// "x,y,z" in metres, or nullopt.
+std::optional<Vec3> parse_point(const std::string& text) {
+  Vec3 p{};
+  size_t at = 0;
+  for (size_t i = 0; i < 3; ++i) {
+    const size_t end = i < 2 ? text.find(',', at) : text.size();
+    if (end == std::string::npos) return std::nullopt;
+    try {
+      size_t used = 0;
+      const std::string field = text.substr(at, end - at);
+      p[i] = std::stod(field, &used);
+      if (used != field.size() || !std::isfinite(p[i])) return std::nullopt;
+    } catch (const std::exception&) {
+      return std::nullopt;
+    }
+    at = end + 1;
+  }
+  return p;
+}
 
 // ---- The inputs -------------------------------------------------------------------------------
 
@@ -353,45 +379,23 @@ Row summarise(const Path& path, const Run& run, const std::vector<Truth>& truths
   return row;
 }
 
+// Over the truth views that show a virtual object (from another viewpoint a sampled frame may face
+// none); -1 when none does.
 double mean_edge_error(const Run& run, const std::vector<Truth>& truths) {
   double sum = 0, length = 0;
   for (size_t k = 0; k < truths.size(); ++k) {
-    if (run.samples[k].alpha.empty()) throw std::runtime_error("a truth view drew no virtual object");
+    if (run.samples[k].alpha.empty()) continue;
     const bench::EdgeError e = bench::occlusion_edge_error(run.samples[k].alpha, truths[k].coverage);
     sum += e.displacement_px * e.edge_length_px;  // weighted by the edge's length: the mean over all edges
     length += e.edge_length_px;
   }
-  return length > 0 ? sum / length : 0;
+  return length > 0 ? sum / length : -1;
 }
 
-int run_hybrid_benchmark(const Options& options) {
-  const sim::SimScene scene = sim::load_sim_scene(options.scene);
-  Config base = load_config(options.config);
-  if (base.source.type != SourceType::Panorama)
-    throw std::invalid_argument(fmt::format("{}: source.type must be \"panorama\"", options.config));
-  if (scene.camera.model.lensmodel() != "LENSMODEL_LONLAT" || scene.camera.stereo.enabled)
-    throw std::invalid_argument(fmt::format("{}: the camera must be a mono LENSMODEL_LONLAT (the panorama)", options.scene));
-  if (scene.trajectory.keyframes.empty() ||
-      norm(scene.trajectory.keyframes.front().position - base.source.panorama.position_m) > 1e-3)
-    throw std::invalid_argument(fmt::format("{}: the scene's first keyframe must be at source.panorama.position_m of {}",
-                                            options.scene, options.config));
-  if (!base.source.panorama.viewpoints.empty())
-    throw std::invalid_argument(fmt::format("{}: one viewpoint a run (no [[source.panorama.viewpoints]])", options.config));
-  const fs::path work = options.work;
+// One viewpoint: its inputs made in `work`, every path run over the sweep, the table printed.
+std::vector<Row> measure_viewpoint(const sim::SimScene& scene, const Config& base, const Options& options,
+                                   const fs::path& work) {
   fs::create_directories(work);
-
-  // The sweep: 720 degrees at the config's rate, as N frames at its frame rate (so a video shows a
-  // new frame each): every frame costs what it would, the yaw steps 720 / N degrees.
-  PanoramaViewConfig& view = base.source.panorama.view;
-  if (view.yaw_rad_per_s == 0) view.yaw_rad_per_s = 12 * kPi / 180;
-  const double sweep_rad = std::copysign(4 * kPi, view.yaw_rad_per_s);
-  view.yaw_rad_per_s = sweep_rad * view.fps / options.frames;
-  view.frames = options.frames + kWarmupFrames;
-  view.yaw_rad -= kWarmupFrames * view.yaw_rad_per_s / view.fps;  // the measured frames start at the config's yaw
-  view.track.clear();
-  view.dwell_s = 0;
-  base.render.blur.method = BlurMethod::Off;  // a panorama's frames are instants
-
   const Inputs in = make_inputs(scene, base, options, work);
 
   std::vector<Path> paths;
@@ -474,8 +478,78 @@ int run_hybrid_benchmark(const Options& options) {
   fmt::print("| path | proxies (triangles) | frames/s min | mean | max | speedup | PSNR (dB) | occlusion edge (px) |\n");
   fmt::print("|---|---|---:|---:|---:|---:|---:|---:|\n");
   for (const Row& row : rows)
-    fmt::print("| {} | {} | {:.1f} | {:.1f} | {:.1f} | {:.2f} | {:.2f} | {:.3f}{} |\n", row.path, row.proxies, row.fps_min,
-               row.fps_mean, row.fps_max, row.fps_mean / rows[0].fps_mean, row.psnr_db, row.edge_px, row.edge_note);
+    fmt::print("| {} | {} | {:.1f} | {:.1f} | {:.1f} | {:.2f} | {:.2f} | {}{} |\n", row.path, row.proxies, row.fps_min,
+               row.fps_mean, row.fps_max, row.fps_mean / rows[0].fps_mean, row.psnr_db,
+               row.edge_px < 0 ? std::string("-") : fmt::format("{:.3f}", row.edge_px), row.edge_note);
+  return rows;
+}
+
+int run_hybrid_benchmark(const Options& options) {
+  const sim::SimScene scene = sim::load_sim_scene(options.scene);
+  Config base = load_config(options.config);
+  if (base.source.type != SourceType::Panorama)
+    throw std::invalid_argument(fmt::format("{}: source.type must be \"panorama\"", options.config));
+  if (scene.camera.model.lensmodel() != "LENSMODEL_LONLAT" || scene.camera.stereo.enabled)
+    throw std::invalid_argument(fmt::format("{}: the camera must be a mono LENSMODEL_LONLAT (the panorama)", options.scene));
+  if (scene.trajectory.keyframes.empty() ||
+      norm(scene.trajectory.keyframes.front().position - base.source.panorama.position_m) > 1e-3)
+    throw std::invalid_argument(fmt::format("{}: the scene's first keyframe must be at source.panorama.position_m of {}",
+                                            options.scene, options.config));
+  if (!base.source.panorama.viewpoints.empty())
+    throw std::invalid_argument(fmt::format(
+        "{}: no [[source.panorama.viewpoints]] here; give the benchmark's viewpoints as --viewpoint X,Y,Z", options.config));
+  const fs::path work = options.work;
+
+  // The sweep: 720 degrees at the config's rate, as N frames at its frame rate (so a video shows a
+  // new frame each): every frame costs what it would, the yaw steps 720 / N degrees.
+  PanoramaViewConfig& view = base.source.panorama.view;
+  if (view.yaw_rad_per_s == 0) view.yaw_rad_per_s = 12 * kPi / 180;
+  const double sweep_rad = std::copysign(4 * kPi, view.yaw_rad_per_s);
+  view.yaw_rad_per_s = sweep_rad * view.fps / options.frames;
+  view.frames = options.frames + kWarmupFrames;
+  view.yaw_rad -= kWarmupFrames * view.yaw_rad_per_s / view.fps;  // the measured frames start at the config's yaw
+  view.track.clear();
+  view.dwell_s = 0;
+  base.render.blur.method = BlurMethod::Off;  // a panorama's frames are instants
+
+  std::vector<Vec3> viewpoints;
+  for (const std::string& text : options.viewpoints) viewpoints.push_back(*parse_point(text));  // checked by the option
+  if (viewpoints.empty()) viewpoints.push_back(base.source.panorama.position_m);
+
+  // Each viewpoint: the scene's camera and the config's panorama moved there together (the
+  // camera's orientation kept), its own inputs in its own folder.
+  std::vector<std::vector<Row>> tables;
+  for (size_t v = 0; v < viewpoints.size(); ++v) {
+    const Vec3 offset = viewpoints[v] - base.source.panorama.position_m;
+    sim::SimScene moved = scene;
+    for (sim::SimKeyframe& keyframe : moved.trajectory.keyframes) {
+      keyframe.position = keyframe.position + offset;
+      keyframe.look_at = keyframe.look_at + offset;
+    }
+    Config at = base;
+    at.source.panorama.position_m = viewpoints[v];
+    tables.push_back(measure_viewpoint(moved, at, options, viewpoints.size() == 1 ? work : work / fmt::format("viewpoint-{}", v)));
+  }
+  if (viewpoints.size() > 1) {
+    // The seed's summary: each path's frames/s and speedup at every viewpoint, and their means.
+    fmt::print("\nAll {} viewpoints (frames/s mean over the sweep; speedup over the full 3D scene at the same viewpoint):\n\n",
+               viewpoints.size());
+    fmt::print("| path | proxies |");
+    for (const Vec3& p : viewpoints) fmt::print(" ({:.2f}, {:.2f}, {:.2f}) |", p[0], p[1], p[2]);
+    fmt::print(" mean speedup |\n|---|---|");
+    for (size_t v = 0; v < viewpoints.size(); ++v) fmt::print("---:|");
+    fmt::print("---:|\n");
+    for (size_t r = 0; r < tables[0].size(); ++r) {
+      fmt::print("| {} | {} |", tables[0][r].path, tables[0][r].proxies);
+      double sum = 0;
+      for (const auto& rows : tables) {
+        const double speedup = rows[r].fps_mean / rows[0].fps_mean;
+        sum += speedup;
+        fmt::print(" {:.1f} ({:.2f}x) |", rows[r].fps_mean, speedup);
+      }
+      fmt::print(" {:.2f} |\n", sum / double(tables.size()));
+    }
+  }
   return 0;
 }
 
@@ -510,6 +584,11 @@ void add_hybrid_benchmark(CLI::App& bench) {
       ->check(CLI::Range(1, 1024))
       ->check(square);
   command->add_option("--ratio", options->ratio, "the simplified proxies' triangle ratio")->check(CLI::Range(2.0, 1000.0));
+  command->add_option("--viewpoint", options->viewpoints,
+                      "a viewpoint X,Y,Z (metres, world), repeatable: each measured in turn with its own panorama, "
+                      "then a summary (default: the config's source.panorama.position_m)")
+      ->type_name("X,Y,Z")
+      ->check(cli::accepted_by([](const std::string& text) { return parse_point(text).has_value(); }, "X,Y,Z in metres"));
   cli::on_run(command, [options] { return run_hybrid_benchmark(*options); }, cli::Failure{});
 }
 

@@ -180,19 +180,26 @@ TEST_F(ArpipeCli, BenchHybridRunsTheSeedsProtocolAgainstTheTruth) {
   if (!benchmarks_built()) GTEST_SKIP() << "arpipe built without the benchmarks";
   const fs::path configs = fs::path(ARPIPE_SOURCE_DIR) / "configs";
   std::string out, err;
+  // Two viewpoints, as the seed's protocol repeats at each: the config's, and one 0.7 m away.
   ASSERT_EQ(run({"bench", "hybrid", "--scene", (configs / "sim" / "courtyard.toml").string(), "--config",
                  (configs / "courtyard.toml").string(), "--work", (dir_ / "hybrid").string(), "--frames", "8",
-                 "--truth-views", "2", "--still-samples", "4", "--video-frames", "2", "--video-samples", "1"},
+                 "--truth-views", "2", "--still-samples", "4", "--video-frames", "2", "--video-samples", "1",
+                 "--viewpoint", "0,0,1.6", "--viewpoint", "0.5,-0.5,1.6"},
                 &out, &err),
             0)
       << err;
-  const std::vector<std::string> full = table_row(out, "full 3D scene");
+  EXPECT_NE(out.find("at (0.50, -0.50, 1.60)"), std::string::npos) << out;
+  const size_t summary = out.find("All 2 viewpoints");
+  ASSERT_NE(summary, std::string::npos) << out;
+  EXPECT_EQ(table_row(out.substr(summary), "hybrid, still").size(), 5u) << out;  // path, proxies, 2 viewpoints, mean
+  const std::string tables = out.substr(0, summary);  // each viewpoint's
+  const std::vector<std::string> full = table_row(tables, "full 3D scene");
   ASSERT_EQ(full.size(), 8u) << out;
   int hybrid_rows = 0;
   for (const char* path : {"hybrid, video", "hybrid, still"})
-    for (size_t at = out.find(std::string("| ") + path + " |"); at != std::string::npos;
-         at = out.find(std::string("| ") + path + " |", at + 1)) {
-      const std::vector<std::string> row = table_row(out.substr(at), path);
+    for (size_t at = tables.find(std::string("| ") + path + " |"); at != std::string::npos;
+         at = tables.find(std::string("| ") + path + " |", at + 1)) {
+      const std::vector<std::string> row = table_row(tables.substr(at), path);
       ASSERT_EQ(row.size(), 8u) << out;
       ++hybrid_rows;
       if (std::string(path) == "hybrid, still") {
@@ -202,15 +209,19 @@ TEST_F(ArpipeCli, BenchHybridRunsTheSeedsProtocolAgainstTheTruth) {
         EXPECT_LE(std::stod(row[7]), 1.0) << "edge\n" << out;
       }
     }
-  EXPECT_EQ(hybrid_rows, 4) << out;  // video and still, proxies whole and 10:1
-  for (const char* file : {"world.glb", "video.mp4", "still/frame_000000.png", "view-0-truth.png"})
-    EXPECT_TRUE(fs::exists(dir_ / "hybrid" / file)) << file;
+  EXPECT_EQ(hybrid_rows, 2 * 4) << out;  // video and still, proxies whole and 10:1, at each viewpoint
+  for (const char* viewpoint : {"viewpoint-0", "viewpoint-1"})
+    for (const char* file : {"world.glb", "video.mp4", "still/frame_000000.png", "view-0-truth.png"})
+      EXPECT_TRUE(fs::exists(dir_ / "hybrid" / viewpoint / file)) << viewpoint << "/" << file;
   // A config that is not a panorama's is refused by name.
   EXPECT_EQ(run({"bench", "hybrid", "--scene", (configs / "sim" / "courtyard.toml").string(), "--config",
                  (configs / "arpipe.toml").string(), "--work", (dir_ / "bad").string()},
                 nullptr, &err),
             1);
   EXPECT_NE(err.find("source.type"), std::string::npos) << err;
+  // A viewpoint that is not three numbers is a usage error naming the option.
+  EXPECT_EQ(run({"bench", "hybrid", "--viewpoint", "1,2"}, nullptr, &err), 2);
+  EXPECT_NE(err.find("--viewpoint"), std::string::npos) << err;
 }
 
 // A config that cannot be read is an error naming it (exit 1), not an uncaught exception.
