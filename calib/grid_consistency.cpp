@@ -37,7 +37,12 @@ OffGridCorner farthest_off_grid(int rows, int cols, const std::vector<Vec2>& pix
         if (board.size() >= kMinNeighbours) break;
       }
       if (board.size() < kMinNeighbours) continue;
-      const cv::Mat H = cv::findHomography(board, image, 0);  // least squares over all of them
+      cv::Mat H;
+      try {
+        H = cv::findHomography(board, image, 0);  // least squares over all of them
+      } catch (const cv::Exception&) {  // degenerate neighbours (all on one line): not judged
+        continue;
+      }
       if (H.empty()) continue;
       const auto map = [&H](double x, double y) {
         const double w = H.at<double>(2, 0) * x + H.at<double>(2, 1) * y + H.at<double>(2, 2);

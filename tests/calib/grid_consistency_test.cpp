@@ -74,5 +74,18 @@ TEST(GridConsistency, MissingCornersAreLeftOutOfTheJudgement) {
   EXPECT_EQ(farthest_off_grid(kRows, kCols, pixels, lonely).index, -1);
 }
 
+// Pixels no homography fits (every corner at one place, or all on one line): nothing is judged,
+// nothing thrown (the detector never throws).
+TEST(GridConsistency, DegenerateGridsAreNotJudged) {
+  std::vector<Vec2> same(size_t(kRows * kCols), Vec2{100, 100});
+  std::vector<double> weights(same.size(), 1.0);
+  EXPECT_NO_THROW(drop_off_grid_corners(kRows, kCols, same, weights));
+  std::vector<Vec2> line;
+  for (int r = 0; r < kRows; ++r)
+    for (int c = 0; c < kCols; ++c) line.push_back({10.0 * (r * kCols + c), 50});
+  std::vector<double> line_weights(line.size(), 1.0);
+  EXPECT_NO_THROW(drop_off_grid_corners(kRows, kCols, line, line_weights));
+}
+
 }  // namespace
 }  // namespace arpipe::calib
