@@ -36,6 +36,7 @@
 #include <vector>
 
 #include "apps/cli/command_line.h"
+#include "apps/cli/number_list.h"
 #include "apps/common/pipeline_assembly.h"
 #include "bench/benchmarks.h"
 #include "bench/pipeline_run.h"
@@ -78,24 +79,7 @@ struct Options {
 };
 
 // "x,y,z" in metres, or nullopt.
-std::optional<Vec3> parse_point(const std::string& text) {
-  Vec3 p{};
-  size_t at = 0;
-  for (size_t i = 0; i < 3; ++i) {
-    const size_t end = i < 2 ? text.find(',', at) : text.size();
-    if (end == std::string::npos) return std::nullopt;
-    try {
-      size_t used = 0;
-      const std::string field = text.substr(at, end - at);
-      p[i] = std::stod(field, &used);
-      if (used != field.size() || !std::isfinite(p[i])) return std::nullopt;
-    } catch (const std::exception&) {
-      return std::nullopt;
-    }
-    at = end + 1;
-  }
-  return p;
-}
+std::optional<Vec3> parse_point(const std::string& text) { return cli::parse_number_list<3>(text); }
 
 // ---- The inputs -------------------------------------------------------------------------------
 

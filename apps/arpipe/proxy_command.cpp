@@ -3,10 +3,8 @@
 // silhouette moved as a camera sees it.
 #include <fmt/format.h>
 
-#include <array>
 #include <cctype>
 #include <cerrno>
-#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -21,6 +19,7 @@
 
 #include "apps/arpipe/commands.h"
 #include "apps/cli/command_line.h"
+#include "apps/cli/number_list.h"
 #include "capture/sinks/output_path.h"
 #include "core/geometry/camera_model.h"
 #include "core/geometry/se3.h"
@@ -51,17 +50,9 @@ struct ProxySimplifyOptions {
 // "RX,RY,RZ,TX,TY,TZ": six finite numbers, the mesh in the camera frame (rotation vector in
 // radians, translation in metres): T_cam_mesh.
 std::optional<SE3> parse_proxy_pose(std::string_view text) {
-  std::array<double, 6> v{};
-  size_t start = 0;
-  for (size_t i = 0; i < v.size(); ++i) {
-    const size_t comma = text.find(',', start);
-    if ((i + 1 < v.size()) != (comma != std::string_view::npos)) return std::nullopt;
-    const std::string_view field = text.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start);
-    const auto [end, ec] = std::from_chars(field.data(), field.data() + field.size(), v[i]);
-    if (ec != std::errc() || end != field.data() + field.size() || !std::isfinite(v[i])) return std::nullopt;
-    start = comma + 1;
-  }
-  return SE3::from_rt({v[0], v[1], v[2]}, {v[3], v[4], v[5]});
+  const auto v = cli::parse_number_list<6>(text);
+  if (!v) return std::nullopt;
+  return SE3::from_rt({(*v)[0], (*v)[1], (*v)[2]}, {(*v)[3], (*v)[4], (*v)[5]});
 }
 
 bool is_glb_name(const fs::path& path) {

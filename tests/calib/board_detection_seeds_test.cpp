@@ -22,17 +22,16 @@ TEST(BoardDetectionSeeds, EachSeedHoldsABoardItsDetectorFinds) {
   const fs::path corpus = fs::path(ARPIPE_SOURCE_DIR) / "tests/fuzz/corpus/fuzz_board_detection";
   for (size_t which = 0; which < std::size(fuzz::kDetectionBoards); ++which) {
     const fs::path seed = corpus / ("board-" + std::to_string(which));
-    std::ifstream in(seed, std::ios::binary);
-    const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-    ASSERT_GT(bytes.size(), 4u) << seed;
+    std::ifstream file(seed, std::ios::binary);
+    const std::string bytes{std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
+    const auto in = fuzz::decode_detection_input(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size());
+    ASSERT_TRUE(in.has_value()) << seed;
     ASSERT_EQ(size_t(bytes[0]), which) << seed;
-    const int width = 8 + (unsigned char)bytes[1] % 121, height = 8 + (unsigned char)bytes[2] % 121;
-    ASSERT_EQ(bytes.size(), 4 + size_t(width) * size_t(height)) << seed;
+    ASSERT_EQ(bytes.size(), 4 + in->grey.size()) << seed;  // the picture whole, nothing repeated
     const CalibrationBoard board = parse_board(fuzz::kDetectionBoards[which], "seed.toml");
     const BoardDetector detector(board);
-    const auto found = detector.detect(reinterpret_cast<const unsigned char*>(bytes.data()) + 4, width, height,
-                                       size_t(width), seed.string());
-    ASSERT_TRUE(found.has_value()) << seed << " (" << width << "x" << height << ")";
+    const auto found = detector.detect(in->grey.data(), in->width, in->height, size_t(in->width), seed.string());
+    ASSERT_TRUE(found.has_value()) << seed << " (" << in->width << "x" << in->height << ")";
     EXPECT_EQ(found->seen_count(), board.point_count()) << seed;
   }
 }

@@ -227,8 +227,7 @@ void config_seeds() {
 }  // namespace
 
 // fuzz_board_detection: each of its boards drawn by `arpipe board`'s writer, shrunk to 96 pixels
-// across with a 12-pixel white border, in the target's input format (board, width - 8, height - 8, detect through a lens
-// too, grey pixels).
+// across with a 12-pixel white border, as the target's input (detected through a lens too).
 void board_detection_seeds(const fs::path& scratch) {
   for (size_t which = 0; which < std::size(fuzz::kDetectionBoards); ++which) {
     const calib::CalibrationBoard board = calib::parse_board(fuzz::kDetectionBoards[which], "seed.toml");
@@ -239,9 +238,10 @@ void board_detection_seeds(const fs::path& scratch) {
     cv::Mat shrunk, small;
     cv::resize(drawn, shrunk, cv::Size(), scale, scale, cv::INTER_AREA);
     cv::copyMakeBorder(shrunk, small, 12, 12, 12, 12, cv::BORDER_CONSTANT, cv::Scalar(255));  // a quiet zone
-    std::string bytes{char(which), char(small.cols - 8), char(small.rows - 8), char(1)};
-    for (int y = 0; y < small.rows; ++y) bytes.append(small.ptr<char>(y), size_t(small.cols));
-    write("fuzz_board_detection", "board-" + std::to_string(which), bytes);
+    std::vector<unsigned char> grey;
+    for (int y = 0; y < small.rows; ++y) grey.insert(grey.end(), small.ptr<unsigned char>(y), small.ptr<unsigned char>(y) + small.cols);
+    write("fuzz_board_detection", "board-" + std::to_string(which),
+          fuzz::encode_detection_input(which, small.cols, small.rows, true, grey));
   }
 }
 
