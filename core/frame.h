@@ -47,6 +47,10 @@ struct FrameMetadata {
   // The index of the source's own frame this one shows, when that differs from the sequence: a
   // panorama video's frame (in presentation order), which repeats on each loop.
   std::optional<int64_t> source_frame_index;
+  // Where that frame lies on the source's own timeline (a panorama video's frame: its index over
+  // the video's nominal rate; a still: 0): the time the scene's animations are sampled at
+  // (render.proxies[].node, light.panorama.lights_animation). None for cameras and recordings.
+  std::optional<int64_t> source_frame_time_ns;
   // The place the source shows, when it has several (a panorama's viewpoint: 0 is source.panorama's
   // own); proxies of other viewpoints are not drawn.
   std::optional<int> viewpoint;

@@ -146,6 +146,7 @@ void RenderStage::configure_loaded(const Config& config, const std::shared_ptr<c
 
   objects_ = std::move(objects);
   proxies_ = std::move(proxies);
+  animator_ = std::make_unique<ProxyAnimator>(config, loaded->meshes, proxies_);
   proxies_cut_for_stereo_ = stereo;
   assets_ = assets;
   proxy_config_ = config;
@@ -187,6 +188,7 @@ void RenderStage::prepare_for_stereo() {
     const auto* loaded = dynamic_cast<const RenderAssets*>(assets_.get());
     if (!loaded) throw std::logic_error("RenderStage: no assets to cut the proxies from");
     proxies_ = upload_proxies(proxy_config_, loaded->meshes, true);
+    animator_ = std::make_unique<ProxyAnimator>(proxy_config_, loaded->meshes, proxies_);
     reuse_.forget();
   }
   proxies_cut_for_stereo_ = true;
@@ -202,6 +204,13 @@ void RenderStage::process(FrameContext& ctx) noexcept {
   ctx.virtual_layer_drawn = false;
   ctx.virtual_layer = {};
   try {
+    // Animated proxies stand where the frame's time puts them, drawn or not (results say where).
+    if (settings_.enabled && animator_ && !animator_->empty()) {
+      if (ctx.camera.meta.eye != Eye::Mono) prepare_for_stereo();  // the cut proxies are the ones placed
+      AnimationReport report;
+      if (animator_->place(proxies_, ctx.camera.meta.source_frame_time_ns, report)) reuse_.forget();
+      ctx.animation = std::move(report);
+    }
     std::string skip;
     if (!settings_.enabled) skip = "render disabled";
     else if (objects_.empty()) skip = "no objects";

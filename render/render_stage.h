@@ -15,6 +15,7 @@
 #include "render/lens/lens_warp_pass.h"
 #include "render/blur/motion_blur.h"
 #include "render/lens/per_model_cache.h"
+#include "render/proxy_animator.h"
 #include "render/uploaded_objects.h"
 #include "render/render_session.h"
 #include "render/scene_physics.h"
@@ -108,6 +109,7 @@ class RenderStage final : public Stage {
   PerModelCache<CameraModel> pinhole_cores_;  // render.lens = "undistort": what the output sees
   std::vector<UploadedObject> objects_;
   std::vector<UploadedObject> proxies_;  // [[render.proxies]], in config order
+  std::unique_ptr<ProxyAnimator> animator_;  // places the animated ones among proxies_ per frame
   // Whether proxies_ are cut for a stereo panorama's eyes (uploaded_objects.h); the meshes and the
   // config they came from, to cut them when an "auto" layout's first eye's frame comes.
   bool proxies_cut_for_stereo_ = false;

@@ -137,7 +137,9 @@ ScenePhysics::ScenePhysics(const Config& config, const LoadedMeshes& meshes)
     spec.name = fmt::format("render.proxies[{}]{}", i, proxy.name.empty() ? "" : fmt::format(" (\"{}\")", proxy.name));
     spec.restitution = proxy.restitution;
     spec.friction = proxy.friction;
-    const SE3 T_world_proxy = proxy_placement(proxy);
+    // A glTF node's proxy stands where its file puts the node (an animated one cannot collide).
+    const ScaledPose rest = proxy_rest_placement(proxy, meshes.proxies[i]);
+    const SE3& T_world_proxy = rest.pose;
     Primitive primitive = Primitive::None;
     MeshCollision collision = MeshCollision::Triangles;
     switch (proxy.collider) {
@@ -154,9 +156,9 @@ ScenePhysics::ScenePhysics(const Config& config, const LoadedMeshes& meshes)
       collision = MeshCollision::ConvexHull;
     SE3 T_proxy_shape;
     if (primitive == Primitive::None)
-      spec.shape = MeshShape{std::make_shared<const Mesh>(mesh), {proxy.scale, proxy.scale, proxy.scale}, collision};
+      spec.shape = MeshShape{std::make_shared<const Mesh>(mesh), {rest.scale, rest.scale, rest.scale}, collision};
     else
-      spec.shape = primitive_shape<ColliderShape>(primitive, mesh, proxy.scale, T_proxy_shape);
+      spec.shape = primitive_shape<ColliderShape>(primitive, mesh, rest.scale, T_proxy_shape);
     spec.T_world_collider = T_world_proxy * T_proxy_shape;
     colliders_.push_back(std::move(spec));
     collider_viewpoint_.push_back(proxy.viewpoint);

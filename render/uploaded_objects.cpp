@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -17,6 +18,7 @@
 #include "core/scene/mesh_convexity.h"
 #include "core/scene/mesh_subdivide.h"
 #include "render/prt/prt_cache.h"
+#include "render/proxy_animator.h"
 #include "render/proxy_clusters.h"
 
 namespace arpipe {
@@ -123,6 +125,40 @@ double mean_projected_radius(const Mesh& mesh) {
   return std::sqrt(area / (4 * 3.14159265358979323846));
 }
 
+// A glTF proxy's part (render.proxies[i].node, or the file without its moving nodes), with the
+// node's place in the file and its animation.
+void load_proxy_node(const Config& config, size_t i, LoadedMeshes::Proxy& entry) {
+  const SceneProxy& proxy = config.render.proxies[i];
+  const std::string where = fmt::format("{}: render.proxies[{}] (mesh \"{}\"{})", config_name(config), i, proxy.mesh,
+                                        proxy.node.empty() ? "" : fmt::format(", node \"{}\"", proxy.node));
+  try {
+    auto mesh = std::make_shared<const Mesh>(load_gltf_mesh(proxy.mesh, GltfMeshSelection{proxy.node, proxy.skip_animated_nodes}));
+    if (!proxy.node.empty()) {
+      auto animation = std::make_shared<const GltfAnimation>(GltfAnimation::load(proxy.mesh, proxy.animation));
+      const std::optional<int> node = animation->find_node(proxy.node);
+      if (!node) throw AssetError(fmt::format("{}: no node \"{}\"", proxy.mesh, proxy.node));
+      entry.node_rest = animation->node_pose_at(*node, 0);
+      if (animation->moves(*node)) {
+        entry.animation_node = *node;
+        entry.animation = std::move(animation);
+      }
+    }
+    entry.mesh = std::move(mesh);
+  } catch (const ConfigError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw AssetError(fmt::format("{}: {}", where, e.what()));
+  }
+  // Colliders are static (core/physics): one that moves with the video would need a kinematic body.
+  // The role matters only where something collides (a render.objects[].physics body).
+  const bool bodies = std::any_of(config.render.objects.begin(), config.render.objects.end(),
+                                  [](const SceneObject& o) { return o.physics.kind != ObjectMotion::None; });
+  if (entry.animation && proxy.roles.collide && bodies)
+    throw ConfigError(fmt::format("{}: the animation \"{}\" moves the node, and an animated proxy cannot have the "
+                                  "\"collide\" role (colliders stand still)",
+                                  where, entry.animation->name()));
+}
+
 }  // namespace
 
 LoadedMeshes load_object_meshes(const Config& config) {
@@ -153,7 +189,9 @@ LoadedMeshes load_object_meshes(const Config& config) {
           throw ConfigError(fmt::format("{}: render.proxies[{}].size_m[{}]: expected a size above 0 m for {}, found {}",
                                         config_name(config), i, k, proxy.mesh, proxy.size_m[k]));
     LoadedMeshes::Proxy entry;
-    entry.mesh = load_proxy_mesh(config, fmt::format("render.proxies[{}].mesh", i), proxy.mesh, proxy.size_m);
+    const std::string key = fmt::format("render.proxies[{}].mesh", i);
+    if (proxy.node.empty() && !proxy.skip_animated_nodes) entry.mesh = load_proxy_mesh(config, key, proxy.mesh, proxy.size_m);
+    else load_proxy_node(config, i, entry);
     if (!proxy.collision_mesh.empty())
       entry.collision = load_proxy_mesh(config, fmt::format("render.proxies[{}].collision_mesh", i), proxy.collision_mesh,
                                         proxy.size_m);
@@ -169,6 +207,10 @@ SE3 proxy_placement(const SceneProxy& proxy) {
          SE3::from_rt({proxy.roll_rad, 0, 0}, {0, 0, 0});
 }
 
+ScaledPose proxy_rest_placement(const SceneProxy& proxy, const LoadedMeshes::Proxy& loaded) {
+  return compose(proxy_placement(proxy), proxy.scale, loaded.node_rest);
+}
+
 std::vector<UploadedObject> upload_proxies(const Config& config, const LoadedMeshes& loaded, bool cut_for_stereo) {
   if (loaded.proxies.size() != config.render.proxies.size())
     throw std::logic_error(fmt::format("upload_proxies: {} proxies loaded for a config with {}", loaded.proxies.size(),
@@ -182,20 +224,21 @@ std::vector<UploadedObject> upload_proxies(const Config& config, const LoadedMes
     UploadedObject object;
     object.mesh_source = proxy.mesh;
     object.name = proxy.name.empty() ? fmt::format("proxy {}", i) : proxy.name;
+    const ScaledPose placed = proxy_rest_placement(proxy, loaded.proxies[i]);
     std::optional<Mesh> cut;
     if (cut_for_stereo) {
       double edge_m = 0;
-      cut = subdivided(*loaded.proxies[i].mesh, kOdsMaxEdgeM / proxy.scale, kMaxStereoProxyTriangles, &edge_m);
-      if (edge_m * proxy.scale > kOdsMaxEdgeM * 1.0001)
+      cut = subdivided(*loaded.proxies[i].mesh, kOdsMaxEdgeM / placed.scale, kMaxStereoProxyTriangles, &edge_m);
+      if (edge_m * placed.scale > kOdsMaxEdgeM * 1.0001)
         log::warn("proxy {}: cut to edges of {:.3g} m for stereo (not {} m: at most {} triangles)", object.name,
-                  edge_m * proxy.scale, kOdsMaxEdgeM, kMaxStereoProxyTriangles);
+                  edge_m * placed.scale, kOdsMaxEdgeM, kMaxStereoProxyTriangles);
     }
     ClusteredMesh clustered = cluster_for_culling(cut ? *cut : *loaded.proxies[i].mesh);
     object.mesh = std::make_shared<const GpuMesh>(clustered.mesh);
-    for (const Bounds& b : clustered.bounds) object.cluster_bounds.push_back(scaled(b, proxy.scale));
-    object.scale = proxy.scale;
-    object.bounds = scaled(loaded.proxies[i].mesh->bounds(), proxy.scale);
-    object.T_world_object = proxy_placement(proxy);
+    for (const Bounds& b : clustered.bounds) object.cluster_bounds.push_back(scaled(b, placed.scale));
+    object.scale = placed.scale;
+    object.bounds = scaled(loaded.proxies[i].mesh->bounds(), placed.scale);
+    object.T_world_object = placed.pose;
     object.proxy = true;
     object.shadow_catcher = proxy.roles.receive_shadows;
     object.writes_depth = proxy.roles.occlude;
@@ -205,7 +248,7 @@ std::vector<UploadedObject> upload_proxies(const Config& config, const LoadedMes
     std::string sizes;
     for (const OccluderLevel& level : cut ? std::vector<OccluderLevel>{} : loaded.proxies[i].occluder_levels) {
       object.occluder_levels.push_back(std::make_shared<const GpuMesh>(*level.mesh));
-      object.occluder_level_errors_m.push_back(level.error * proxy.scale);
+      object.occluder_level_errors_m.push_back(level.error * object.scale);
       sizes += fmt::format(", {} ({:.2g} mm)", level.mesh->triangle_count(), 1e3 * object.occluder_level_errors_m.back());
     }
     if (!sizes.empty())

@@ -12,6 +12,7 @@
 #include "core/config/config.h"
 #include "core/geometry/se3.h"
 #include "render/gl/gpu_mesh.h"
+#include "core/scene/gltf_animation.h"
 #include "core/scene/mesh.h"
 #include "core/scene/occluder_levels.h"
 
@@ -86,6 +87,11 @@ struct LoadedMeshes {
     std::shared_ptr<const Mesh> mesh;
     std::shared_ptr<const Mesh> collision;
     std::vector<OccluderLevel> occluder_levels;  // made only for proxies that occlude
+    // render.proxies[i].node: where the node stands in its file at the animation's start, and the
+    // animation when it moves the node (render/proxy_animator.h); else at rest and null.
+    ScaledPose node_rest;
+    std::shared_ptr<const GltfAnimation> animation;
+    int animation_node = -1;
   };
   std::vector<Proxy> proxies;
 };
@@ -100,6 +106,9 @@ std::vector<UploadedObject> upload_objects(const Config& config, const LoadedMes
 std::vector<UploadedObject> upload_proxies(const Config& config, const LoadedMeshes& loaded, bool cut_for_stereo = false);
 // A proxy's placement: R = Rz(yaw) Ry(pitch) Rx(roll), at position_m.
 SE3 proxy_placement(const SceneProxy& proxy);
+// Where it stands at rest: that placement (and scale) after its node's place in its file at the
+// animation's start (render.proxies[i].node; nothing without one).
+ScaledPose proxy_rest_placement(const SceneProxy& proxy, const LoadedMeshes::Proxy& loaded);
 
 // Both of the above, on the calling thread.
 std::vector<UploadedObject> load_and_upload_objects(const Config& config);

@@ -64,6 +64,8 @@ void PanoramaPlace::arrive() {
   if (!is_video_) return;
   video_ = std::make_unique<PanoramaVideo>(viewpoint_.file, layout_, hardware_decoding_);
   video_frame_ns_ = std::max<int64_t>(1, (1'000'000'000 * video_->rate_den() + video_->rate_num() / 2) / video_->rate_num());
+  rate_num_ = video_->rate_num();
+  rate_den_ = video_->rate_den();
   loop_offset_ns_ = 0;
   if (!video_->next(shown_)) throw AssetError(fmt::format("panorama video \"{}\": no frame decodes", viewpoint_.file.string()));
   has_upcoming_ = video_->next(upcoming_);
@@ -113,6 +115,15 @@ EquirectImage& PanoramaPlace::show_at(int64_t t_ns, Eye eye) {
 std::optional<int64_t> PanoramaPlace::frame_index() const {
   if (!is_video_) return std::nullopt;
   return shown_.index;
+}
+
+int64_t PanoramaPlace::frame_time_ns() const {
+  if (!is_video_) return 0;
+  // index * den / num seconds, exact in 128 bits (a long loop's index times 1e9 times den would
+  // overflow 64), then rounded.
+  __extension__ typedef __int128 Int128;
+  const Int128 numerator = Int128(shown_.index) * rate_den_ * 1'000'000'000;
+  return int64_t((numerator + rate_num_ / 2) / rate_num_);
 }
 
 std::string PanoramaPlace::describe() const {

@@ -40,6 +40,9 @@ class PanoramaPlace {
 
   // The shown video frame's index (presentation order from 0); none for a still.
   std::optional<int64_t> frame_index() const;
+  // Where the shown frame lies on the video's timeline: its index over the nominal rate, rounded to
+  // the nanosecond (the time a pre-rendered video's animation had at that frame); 0 for a still.
+  int64_t frame_time_ns() const;
   const std::optional<ShRgb9>& light_sh() const { return light_sh_; }
   const PanoramaViewpoint& viewpoint() const { return viewpoint_; }
   // Whether it holds two eyes (its layout, resolved from the file for "auto").
@@ -63,6 +66,7 @@ class PanoramaPlace {
   bool has_upcoming_ = false;
   int64_t loop_offset_ns_ = 0;  // the durations of the passes done
   int64_t video_frame_ns_ = 0;  // one frame at the video's nominal rate
+  int64_t rate_num_ = 1, rate_den_ = 1;  // the nominal rate, frames per second as a fraction
   uint64_t skipped_before_ = 0;  // by the decoders of earlier visits
   std::unique_ptr<PanoramaLight> light_;     // a video's, for each frame shown
   std::optional<ShRgb9> light_sh_;

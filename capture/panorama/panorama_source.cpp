@@ -147,6 +147,7 @@ SourceStatus PanoramaSource::next(Frame& frame) {
     frame.meta.timestamp_offset_ns = s.config.timestamp_offset_ns;
     frame.meta.known_T_cam_world = panorama_view_pose(place.viewpoint(), R_pano_cam);
     frame.meta.source_frame_index = place.frame_index();
+    frame.meta.source_frame_time_ns = place.frame_time_ns();
     frame.meta.viewpoint = int(s.here);
     frame.meta.eye = eye;
     frame.meta.environment_sh = place.light_sh();

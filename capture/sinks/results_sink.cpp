@@ -116,6 +116,16 @@ nlohmann::json ResultsSink::to_json(const FrameContext& ctx) {
                                  {"beyond_radius", p.removed_beyond_radius},
                                  {"non_finite", p.removed_non_finite}}}};
   }
+  if (ctx.animation) {
+    json proxies = json::array();
+    for (const AnimationReport::Proxy& p : ctx.animation->proxies)
+      proxies.push_back({{"name", p.name},
+                         {"position_m", {p.position_m[0], p.position_m[1], p.position_m[2]}},
+                         {"rotation_vector", {p.rotation_vector[0], p.rotation_vector[1], p.rotation_vector[2]}},
+                         {"scale", p.scale}});
+    j["animation"] = {{"time_s", ctx.animation->time_s}, {"proxies", std::move(proxies)}};
+  }
+  if (ctx.camera.meta.source_frame_time_ns) j["source_frame_time_s"] = 1e-9 * double(*ctx.camera.meta.source_frame_time_ns);
   json timings = json::object();
   json skips = json::object();
   for (const auto& t : ctx.timings) {

@@ -315,6 +315,14 @@ struct SceneProxy {
   // A panorama source's viewpoint this proxy stands in (source.panorama: 0 its own table, k the
   // k-th [[source.panorama.viewpoints]]); -1: every frame. Its collider, too, stops bodies only there.
   int viewpoint = -1;
+  // A glTF mesh's parts (core/scene/gltf_animation.h). node: only that node and its subtree, in the
+  // node's own frame, placed where the file's animation puts the node at each frame's time
+  // (render/proxy_animator.h) and then by position/yaw/.../scale; "": the whole file.
+  // skip_animated_nodes: the file without the nodes its animations move (the static rest of an
+  // animated scene). animation: which of the file's animations ("": its first).
+  std::string node;
+  bool skip_animated_nodes = false;
+  std::string animation;
 
   bool operator==(const SceneProxy&) const = default;
 };
@@ -338,6 +346,10 @@ void visit(V& v, SceneProxy& s) {
   v.key("friction", s.friction, NumberRange::closed(0, 10), "1: the body's own applies");
   v.key("viewpoint", s.viewpoint, IntRange{-1, int(PanoramaConfig::kMaxViewpoints) - 1},
         "the panorama viewpoint it stands in (0: source.panorama's own); -1: every frame");
+  v.key("node", s.node,
+        "a glTF mesh's node: only its subtree, placed where the file's animation puts it at the frame's time; \"\": the whole file");
+  v.key("skip_animated_nodes", s.skip_animated_nodes, "leave out the glTF nodes its animations move (the static rest)");
+  v.key("animation", s.animation, "which of the glTF file's animations moves the node (\"\": its first)");
 }
 
 // The rigid-body world of render.objects[].physics and the "collide" proxies (core/physics).
@@ -641,6 +653,9 @@ struct PanoramaLightConfig {
   // units (lux; candela over the squared distance to the world origin) into the render's irradiance.
   std::filesystem::path lights_file;
   double lights_scale = 1;
+  // Which of lights_file's animations moves its lights' nodes ("": its first), sampled at each
+  // frame's time in the panorama's video (FrameMetadata::source_frame_time_ns).
+  std::string lights_animation;
 
   bool operator==(const PanoramaLightConfig&) const = default;
 };
@@ -654,6 +669,8 @@ void visit(V& v, PanoramaLightConfig& s) {
         "a glTF whose KHR_lights_punctual lights are the direct lights instead of render.light_* (the brightest casts shadows)");
   v.key("lights_scale", s.lights_scale, NumberRange::open_closed(0, 1e12),
         "lights_file's lux (directional; candela / distance^2 from the world origin for point and spot) to irradiance");
+  v.key("lights_animation", s.lights_animation,
+        "which of lights_file's animations moves its lights, at the video frame's time (\"\": its first)");
 }
 
 // The light stage: where the light comes from.

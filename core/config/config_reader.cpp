@@ -14,6 +14,7 @@
 #include "core/config/text_file.h"
 #include "core/config/toml_section.h"
 #include "core/image/camera_response.h"
+#include "core/scene/builtin_meshes.h"
 #include "core/track/tag_family.h"
 
 namespace arpipe {
@@ -117,6 +118,15 @@ void check_cross_keys(const TomlSection& t, ObjectPhysics& s) {
                                        toml_float(s.track[i].time_s), toml_float(s.track[i - 1].time_s)));
   if (!s.track.empty() && s.kind != ObjectMotion::Kinematic)
     t.fail_with("track", fmt::format("a pose track moves only a kinematic body, not a {} one", object_motion_name(s.kind)));
+}
+
+void check_cross_keys(const TomlSection& t, SceneProxy& s) {
+  const bool builtin = is_builtin_mesh_source(s.mesh);
+  if (builtin && !s.node.empty()) t.fail_with("node", fmt::format("a node is a glTF file's; mesh is {}", toml_quoted(s.mesh)));
+  if (builtin && s.skip_animated_nodes)
+    t.fail_with("skip_animated_nodes", fmt::format("animated nodes are a glTF file's; mesh is {}", toml_quoted(s.mesh)));
+  if (!s.node.empty() && s.skip_animated_nodes)
+    t.fail_with("skip_animated_nodes", "a proxy takes one node (node) or the file without its moving nodes, not both");
 }
 
 void check_cross_keys(const TomlSection& t, Config& c) {

@@ -10,7 +10,7 @@
 #include <stdexcept>
 
 #include "core/environment/environment_light.h"
-#include "core/scene/gltf_loader.h"
+#include "core/scene/gltf_animation.h"
 #include "core/sh/sh_window.h"
 #include "core/log.h"
 #include "core/pipeline/monotonic_clock.h"
@@ -30,19 +30,15 @@ int64_t realtime_minus_monotonic_ns() {
 struct EnvironmentAssets final : StageAssets {
   std::optional<LightEstimate> environment;
   std::vector<DirectionalLight> scene_lights;
+  std::shared_ptr<const GltfAnimation> lights_animation;  // when it moves a light
 };
 
 // light.panorama.lights_file's lights in the render's units: a directional light's irradiance is its
 // lux times the scale; a point or spot light is a lamp at its place whose irradiance at the world
-// origin is its candela over the squared distance (the spot's cone is not modelled).
-std::vector<DirectionalLight> scene_lights(const Config& config) {
+// origin is its candela over the squared distance (the spot's cone is not modelled); strongest first.
+// A lamp at the world origin has no direction from there: left out (warned about when `warn`).
+std::vector<DirectionalLight> direct_lights(const std::vector<GltfLight>& file_lights, const Config& config, bool warn) {
   const PanoramaLightConfig& c = config.light.panorama;
-  std::vector<GltfLight> file_lights;
-  try {
-    file_lights = load_gltf_lights(c.lights_file);
-  } catch (const std::exception& e) {
-    throw ConfigError(fmt::format("{}: light.panorama.lights_file: {}", config.file.string(), e.what()));
-  }
   std::vector<DirectionalLight> out;
   for (const GltfLight& light : file_lights) {
     DirectionalLight d;
@@ -54,7 +50,9 @@ std::vector<DirectionalLight> scene_lights(const Config& config) {
     } else {
       const double distance = norm(light.position);
       if (!(distance > 1e-6)) {
-        log::warn("{}: light \"{}\" (node {}) sits at the world origin: left out", c.lights_file.string(), light.name, light.node);
+        if (warn)
+          log::warn("{}: light \"{}\" (node {}) sits at the world origin: left out", c.lights_file.string(), light.name,
+                    light.node);
         continue;
       }
       d.local = true;
@@ -64,23 +62,52 @@ std::vector<DirectionalLight> scene_lights(const Config& config) {
     }
     out.push_back(d);
   }
-  if (out.empty())
-    throw ConfigError(fmt::format("{}: light.panorama.lights_file: {} has no KHR_lights_punctual light on its scene's nodes",
-                                  config.file.string(), c.lights_file.string()));
   std::stable_sort(out.begin(), out.end(), [](const DirectionalLight& a, const DirectionalLight& b) {
     return std::max({a.irradiance[0], a.irradiance[1], a.irradiance[2]}) > std::max({b.irradiance[0], b.irradiance[1], b.irradiance[2]});
   });
   return out;
 }
 
+// The file's lights at the animation's start, and the animation when it moves one of them.
+void load_scene_lights(const Config& config, EnvironmentAssets& assets) {
+  const PanoramaLightConfig& c = config.light.panorama;
+  std::vector<GltfLight> file_lights;
+  try {
+    auto animation = std::make_shared<const GltfAnimation>(GltfAnimation::load(c.lights_file, c.lights_animation));
+    file_lights = animation->lights_at(0);
+    if (std::any_of(file_lights.begin(), file_lights.end(), [&](const GltfLight& l) { return animation->moves(l.node); }))
+      assets.lights_animation = std::move(animation);
+  } catch (const std::exception& e) {
+    throw ConfigError(fmt::format("{}: light.panorama.lights_file: {}", config.file.string(), e.what()));
+  }
+  assets.scene_lights = direct_lights(file_lights, config, true);
+  if (assets.scene_lights.empty())
+    throw ConfigError(fmt::format("{}: light.panorama.lights_file: {} has no KHR_lights_punctual light on its scene's nodes",
+                                  config.file.string(), c.lights_file.string()));
+}
+
 }  // namespace
+
+void LightStage::pose_scene_lights(FrameContext& ctx) noexcept {
+  // The frame's time on the video's timeline (a still, or a frame without one: the start).
+  const int64_t t_ns = ctx.camera.meta.source_frame_time_ns.value_or(0);
+  if (panorama_.posed_at_ns == t_ns) return;
+  try {
+    std::vector<DirectionalLight> lights = direct_lights(panorama_.animation->lights_at(1e-9 * double(t_ns)), panorama_.config, false);
+    if (lights.empty()) throw std::runtime_error("every light sits at the world origin");
+    panorama_.direct = std::move(lights);
+    panorama_.posed_at_ns = t_ns;
+  } catch (const std::exception& e) {  // the last posed lights stay
+    ctx.light.note = fmt::format("the scene's lights at {:.3f} s: {}", 1e-9 * double(t_ns), e.what());
+  }
+}
 
 StageAssetLoader LightStage::asset_loader() const {
   return [](const Config& config) -> std::shared_ptr<const StageAssets> {
     auto assets = std::make_shared<EnvironmentAssets>();
     if (config.light.source == LightSource::Environment) assets->environment = load_environment_lighting(config).estimate;
     if (config.light.source == LightSource::Panorama && !config.light.panorama.lights_file.empty())
-      assets->scene_lights = scene_lights(config);
+      load_scene_lights(config, *assets);
     return assets;
   };
 }
@@ -129,6 +156,8 @@ void LightStage::configure_loaded(const Config& config, const std::shared_ptr<co
     panorama_ = PanoramaLighting{};
     panorama_.window = light.panorama.window;
     panorama_.direct = loaded->scene_lights;
+    panorama_.animation = loaded->lights_animation;
+    panorama_.config = config;
     if (!light.panorama.lights_file.empty())
       log::info("light: {} direct light(s) from {}, the strongest casting shadows", panorama_.direct.size(),
                 light.panorama.lights_file.string());
@@ -178,6 +207,7 @@ void LightStage::process(FrameContext& ctx) noexcept {
     ctx.light.ambient_sh = *sh;
     for (size_t i = 0; i < 9; ++i)
       ctx.light.ambient_sh[i] = sh_window_factor(panorama_.window, sh_band(int(i)), 3) * ctx.light.ambient_sh[i];
+    if (panorama_.animation) pose_scene_lights(ctx);
     ctx.light.lights = panorama_.direct;
     ctx.light.scene_linear = true;
     ctx.light.confidence = 1;

@@ -13,6 +13,7 @@
 #include "core/config/light_source.h"
 #include "core/light/ground_radiance.h"
 #include "core/probe/probe_light_estimator.h"
+#include "core/scene/gltf_animation.h"
 #include "core/sh/sh_window.h"
 #include "core/sun/sun_light.h"
 #include "core/pipeline/stage.h"
@@ -41,7 +42,12 @@ class LightStage final : public Stage {
   struct PanoramaLighting {
     std::vector<DirectionalLight> direct;  // lights_file's, else render.light_* unless direct_light_from_render is off
     ShWindow window = ShWindow::None;
+    // lights_file's animation, when it moves a light: the lights posed at each frame's time.
+    std::shared_ptr<const GltfAnimation> animation;
+    Config config;  // lights_scale and the light's size, for posing them
+    std::optional<int64_t> posed_at_ns = int64_t{0};
   } panorama_;                   // Panorama: with the SH each frame brings
+  void pose_scene_lights(FrameContext& ctx) noexcept;
   Vec3 probe_centre_{0, 0, 0};
   Vec3 ground_albedo_{0.3, 0.3, 0.3};
   CameraResponse response_;

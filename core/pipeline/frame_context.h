@@ -102,6 +102,7 @@ struct FrameContext {
   // the config has proxies or physics).
   std::vector<ObjectReport> objects;
   std::optional<PhysicsReport> physics;  // with a physics world (render.objects[].physics)
+  std::optional<AnimationReport> animation;  // with animated proxies (render.proxies[].node)
   std::vector<StageTiming> timings;
   uint64_t input_index = 0;                     // position in the stream as the pipeline saw it
   uint64_t dropped_before = 0;                  // frames lost just before this one (sequence gap or queue drop)

@@ -25,6 +25,19 @@ struct ObjectReport {
   std::vector<std::pair<std::string, double>> hidden_by;
 };
 
+// The scene's animation at the frame (render.proxies[].node of an animated glTF): the time it was
+// sampled at (FrameMetadata::source_frame_time_ns) and where each animated proxy stood then.
+struct AnimationReport {
+  double time_s = 0;
+  struct Proxy {
+    std::string name;
+    Vec3 position_m{0, 0, 0};   // the proxy's origin in the world
+    Vec3 rotation_vector{0, 0, 0};
+    double scale = 1;
+  };
+  std::vector<Proxy> proxies;
+};
+
 // The rigid-body world's counters (render/scene_physics.h), since the daemon started, for the
 // frames of a config with physics: what was simulated and what left the world.
 struct PhysicsReport {

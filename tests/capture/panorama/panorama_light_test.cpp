@@ -199,5 +199,54 @@ TEST(PanoramaLight, TheScenesExportedLightsAreTheDirectLightsStrongestFirst) {
   }
 }
 
+TEST(PanoramaLight, AnAnimatedLampStandsWhereTheVideoFramesTimePutsIt) {
+  // A 20 cd lamp whose node moves linearly from glTF (1, 3, 3) at 0 s to (3, 3, -1) at 2 s (z-up:
+  // from (1, -3, 3) to (3, 1, 3)): each frame's lamp is there at its source_frame_time_ns, held at
+  // the last key after 2 s, and at the start on a frame without a time.
+  const auto dir = test::scratch_dir("panorama-animated-lights");
+  std::ofstream(dir / "lights.gltf") << R"({"asset": {"version": "2.0"},
+    "extensions": {"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 20.0}]}},
+    "scenes": [{"nodes": [0]}],
+    "nodes": [{"name": "lamp", "translation": [1.0, 3.0, 3.0], "extensions": {"KHR_lights_punctual": {"light": 0}}}],
+    "buffers": [{"byteLength": 32, "uri": "data:application/octet-stream;base64,AAAAAAAAAEAAAIA/AABAQAAAQEAAAEBAAABAQAAAgL8="}],
+    "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 8}, {"buffer": 0, "byteOffset": 8, "byteLength": 24}],
+    "accessors": [{"bufferView": 0, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0.0], "max": [2.0]},
+                  {"bufferView": 1, "componentType": 5126, "count": 2, "type": "VEC3"}],
+    "animations": [{"name": "walk", "channels": [{"sampler": 0, "target": {"node": 0, "path": "translation"}}],
+                    "samplers": [{"input": 0, "output": 1, "interpolation": "LINEAR"}]}]})";
+  Config config;
+  config.source.type = SourceType::Panorama;
+  config.light.source = LightSource::Panorama;
+  config.light.panorama.lights_file = dir / "lights.gltf";
+  LightStage stage;
+  stage.configure(config);
+  const auto lamp_at = [&](std::optional<int64_t> t_ns) {
+    FrameContext ctx;
+    ctx.camera.meta.environment_sh = ShRgb9{};
+    ctx.camera.meta.source_frame_time_ns = t_ns;
+    stage.process(ctx);
+    EXPECT_EQ(ctx.light.lights.size(), 1u);
+    EXPECT_TRUE(ctx.light.note.empty()) << ctx.light.note;
+    return ctx.light.lights.empty() ? Vec3{0, 0, 0} : ctx.light.lights[0].position_world;
+  };
+  for (const auto& [t_ns, expected] : {std::pair{std::optional<int64_t>(0), Vec3{1, -3, 3}},
+                                       std::pair{std::optional<int64_t>(1'000'000'000), Vec3{2, -1, 3}},
+                                       std::pair{std::optional<int64_t>(500'000'000), Vec3{1.5, -2, 3}},
+                                       std::pair{std::optional<int64_t>(5'000'000'000), Vec3{3, 1, 3}},
+                                       std::pair{std::optional<int64_t>(), Vec3{1, -3, 3}}}) {
+    const Vec3 at = lamp_at(t_ns);
+    for (size_t i = 0; i < 3; ++i) EXPECT_NEAR(at[i], expected[i], 1e-6) << "at " << t_ns.value_or(-1) << " ns, axis " << i;
+  }
+  // An animation name the file does not have is a setup error naming the key.
+  config.light.panorama.lights_animation = "run";
+  try {
+    stage.configure(config);
+    ADD_FAILURE() << "an animation the file lacks was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("light.panorama.lights_file"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("run"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace arpipe

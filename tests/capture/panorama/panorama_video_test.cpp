@@ -24,51 +24,23 @@ extern "C" {
 #include "capture/panorama/panorama_video.h"
 #include "core/scene/asset_error.h"
 #include "tests/capture/capture_test_support.h"
+#include "tests/support/barcode_video.h"
 
 namespace arpipe {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr int kWidth = 256, kHeight = 128, kBits = 12;
+constexpr int kWidth = test::kBarcodeWidth;
 
-// Frame i: grey, with bit b of i as a 16 x 64 block (white 1, black 0) at column 16 b.
-std::vector<uint8_t> barcode_frame(int i) {
-  std::vector<uint8_t> rgb(size_t(kWidth) * kHeight * 3, 128);
-  for (int b = 0; b < kBits; ++b)
-    for (int y = 32; y < 96; ++y)
-      for (int x = 16 * b; x < 16 * b + 16; ++x)
-        for (int c = 0; c < 3; ++c) rgb[(size_t(y) * kWidth + size_t(x)) * 3 + size_t(c)] = (i >> b) & 1 ? 255 : 0;
-  return rgb;
-}
+int read_barcode(const PanoramaVideoFrame& frame) { return test::read_barcode(frame.rgb, frame.width); }
 
-int read_barcode(const PanoramaVideoFrame& frame) {
-  int i = 0;
-  for (int b = 0; b < kBits; ++b)
-    if (frame.rgb[(size_t(64) * size_t(frame.width) + size_t(16 * b + 8)) * 3] > 128) i |= 1 << b;
-  return i;
-}
-
-// Encodes `frames` barcoded frames at 30 frames/s with ffmpeg's arguments `codec`.
 fs::path make_video(const fs::path& dir, const std::string& name, int frames, const std::string& codec) {
-  const fs::path raw = dir / (name + ".rgb"), out = dir / name;
-  {
-    std::ofstream file(raw, std::ios::binary);
-    for (int i = 0; i < frames; ++i) {
-      const std::vector<uint8_t> rgb = barcode_frame(i);
-      file.write(reinterpret_cast<const char*>(rgb.data()), std::streamsize(rgb.size()));
-    }
-  }
-  const std::string command = fmt::format(
-      "ffmpeg -nostdin -v error -y -f rawvideo -pix_fmt rgb24 -s {}x{} -r 30 -i '{}' {} -pix_fmt yuv420p '{}'", kWidth,
-      kHeight, raw.string(), codec, out.string());
-  EXPECT_EQ(std::system(command.c_str()), 0) << command;
-  fs::remove(raw);
-  return out;
+  return test::make_barcode_video(dir, name, frames, codec);
 }
 
 const fs::path& h264_with_b_frames() {
   static const fs::path file =
-      make_video(test::scratch_dir("panorama-video"), "b-frames.mp4", 64, "-c:v libx264 -preset veryfast -bf 3 -g 20 -crf 12");
+      make_video(test::scratch_dir("panorama-video"), "b-frames.mp4", 64, test::kH264WithBFrames);
   return file;
 }
 
@@ -184,6 +156,9 @@ TEST(PanoramaVideo, TheSourceShowsEachOutputFrameTheVideoFrameOfItsTime) {
     ASSERT_EQ(source.next(frame), SourceStatus::Frame);
     ASSERT_TRUE(frame.meta.source_frame_index);
     EXPECT_EQ(*frame.meta.source_frame_index, (k / 2) % 64) << "output frame " << k;
+    // The animation's time (render/proxy_animator.h) is that index over the video's 30 frames/s.
+    ASSERT_TRUE(frame.meta.source_frame_time_ns);
+    EXPECT_EQ(*frame.meta.source_frame_time_ns, (int64_t((k / 2) % 64) * 1'000'000'000 + 15) / 30) << "output frame " << k;
     const uint8_t centre = frame.data[16 * frame.bytes_per_line + 3 * 32];
     EXPECT_EQ(centre > 128, bool(*frame.meta.source_frame_index & 1)) << "output frame " << k << ": " << int(centre);
   }

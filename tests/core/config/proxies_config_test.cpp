@@ -136,6 +136,30 @@ TEST(ProxiesConfig, RefusesBadRowsNamingThePlace) {
                      {"render.objects[0].physics.track", "kinematic"});
 }
 
+TEST(ProxiesConfig, ReadsAnAnimatedNodeAndRefusesItOnABuiltin) {
+  const Config c = parse_config(R"(
+[[render.proxies]]
+mesh = "scene.glb"
+skip_animated_nodes = true
+
+[[render.proxies]]
+mesh = "scene.glb"
+node = "cart"
+animation = "drive"
+)", "p.toml");
+  ASSERT_EQ(c.render.proxies.size(), 2u);
+  EXPECT_TRUE(c.render.proxies[0].skip_animated_nodes);
+  EXPECT_TRUE(c.render.proxies[0].node.empty());
+  EXPECT_EQ(c.render.proxies[1].node, "cart");
+  EXPECT_EQ(c.render.proxies[1].animation, "drive");
+  EXPECT_FALSE(c.render.proxies[1].skip_animated_nodes);
+  expect_proxy_error("[[render.proxies]]\nmesh = \"builtin:box\"\nnode = \"cart\"\n",
+                     {"render.proxies[0].node", "glTF", "builtin:box"});
+  expect_proxy_error("[[render.proxies]]\nskip_animated_nodes = true\n", {"render.proxies[0].skip_animated_nodes", "glTF"});
+  expect_proxy_error("[[render.proxies]]\nmesh = \"a.glb\"\nnode = \"cart\"\nskip_animated_nodes = true\n",
+                     {"render.proxies[0].skip_animated_nodes", "not both"});
+}
+
 // --defaults prints the rows (a commented-out proxy with every role) and reads back as the defaults.
 TEST(ProxiesConfig, DefaultsListTheNewRows) {
   const std::string text = default_config_toml();
