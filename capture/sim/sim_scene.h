@@ -61,6 +61,12 @@ struct SimMaterial {
 inline constexpr ChoiceName<SimMaterial::Kind> kSimMaterialKindNames[] = {{"lambertian", SimMaterial::Kind::Lambertian},
                                                                           {"mirror", SimMaterial::Kind::Mirror}};
 
+// A key of an object's pose track: where the object's frame sits at this time.
+struct SimPoseKey {
+  double time_s = 0;  // trajectory time (since the first frame's exposure start); >= 0, strictly increasing
+  SE3 T_world_object;
+};
+
 struct SimObject {
   enum class Shape { Plane, Sphere, Mesh };
   std::string name;  // unique within the scene, as written in the scene file
@@ -79,6 +85,9 @@ struct SimObject {
   SimMaterial material;
   bool is_virtual = false;  // left out of the camera frames, drawn only in the ground-truth composite
   bool casts_shadows = true;
+  // A pose track (object_pose_at): empty for an object that stands still at T_world_object. The
+  // loader makes T_world_object the first key's pose, where the object stands before that key.
+  std::vector<SimPoseKey> keyframes;
 };
 inline constexpr ChoiceName<SimObject::Shape> kSimShapeNames[] = {
     {"plane", SimObject::Shape::Plane}, {"sphere", SimObject::Shape::Sphere}, {"mesh", SimObject::Shape::Mesh}};
@@ -247,6 +256,17 @@ struct SimScene {
   SimRender render;
 
   bool has_virtual_objects() const;
+  // Whether an object has a pose track (keyframes), so that the world changes from frame to frame.
+  bool has_animated_objects() const;
 };
+
+// Where an object stands at trajectory time t_s: T_world_object without keys; else the end keys'
+// poses outside their times (also for a NaN time: the first's), and between two keys
+// SE3::interpolate (translation linear, rotation slerped the short way at constant speed): glTF's
+// LINEAR translation and rotation channels with the same keys.
+SE3 object_pose_at(const SimObject& object, double t_s);
+// The scene as a still at trajectory time t_s: every object placed at object_pose_at(t_s), its
+// keys dropped. What frame k of a video of the scene shows (t_s = its exposure start, k / fps).
+SimScene scene_at_time(const SimScene& scene, double t_s);
 
 }  // namespace arpipe::sim

@@ -44,6 +44,8 @@ constexpr double kNsPerMs = 1e6;
 constexpr size_t kMaxObjects = 1000;
 constexpr size_t kMaxLights = 100;
 constexpr size_t kMaxKeyframes = 100000;
+// An object's pose track: a key per frame of a five-minute video at 30 fps is 9000.
+constexpr size_t kMaxObjectKeyframes = 10000;
 constexpr size_t kMaxListNumbers = 10000;  // exposure cycles, intrinsics (a splined model has a few thousand)
 // `up` closer than this (sine of the angle) to the viewing direction leaves the image's roll
 // undefined for practical purposes (0.06 degrees).
@@ -479,6 +481,61 @@ Vec3 read_mesh_size(const TomlSection& s, std::string_view source) {
   return size;
 }
 
+// ---- [[object.keyframe]] -------------------------------------------------------------------------
+
+// Between two keys the rotation takes the short way, which near a half turn is ill-defined (and
+// lost to the float quaternions of an exported glTF): a bigger turn needs a key in between.
+constexpr double kMaxKeyTurnDeg = 179.0;
+// How closely an animated object's own position and rotation_deg must match its first key's.
+constexpr double kPoseMatchM = 1e-9;
+constexpr double kPoseMatchRad = 1e-9;
+
+// One key of object `name`'s pose track; its position and rotation_deg default to the object's.
+SimPoseKey read_pose_key(const TomlSection& k, const std::string& name, const Vec3& position, const Vec3& rotation_deg,
+                         const SimPoseKey* previous) {
+  if (!k.has("time_s"))
+    k.fail("time_s", fmt::format("the key's time in seconds (>= 0) on object \"{}\"'s pose track", name), "nothing");
+  SimPoseKey key;
+  key.time_s = k.number("time_s", 0, kNonNegative.in("s"));
+  if (previous != nullptr && !(key.time_s > previous->time_s))
+    k.fail("time_s",
+           fmt::format("a time after the previous key's {} s (object \"{}\": times must strictly increase)",
+                       previous->time_s, name),
+           fmt::format("{} s", key.time_s));
+  key.T_world_object = SE3::from_rt(kRadiansPerDegree * k.vec3("rotation_deg", rotation_deg), k.vec3("position", position));
+  if (previous != nullptr) {
+    const double turn_deg = rotation_angle_between(previous->T_world_object, key.T_world_object) / kRadiansPerDegree;
+    if (turn_deg > kMaxKeyTurnDeg)
+      k.fail(k.has("rotation_deg") ? "rotation_deg" : "time_s",
+             fmt::format("a turn of at most {:g} degrees from the previous key (object \"{}\": between two keys the "
+                         "rotation takes the short way, ambiguous near a half turn; add a key in between)",
+                         kMaxKeyTurnDeg, name),
+             fmt::format("{:.6g} degrees", turn_deg));
+  }
+  return key;
+}
+
+// The object's pose track, if it has one; T_world_object becomes the first key's pose, which the
+// object's own position and rotation_deg, when given, must match (else they would be ignored).
+void read_pose_track(const TomlSection& s, SimObject& out, const Vec3& position, const Vec3& rotation_deg) {
+  for (const TomlSection& k : table_array(s, "keyframe", kMaxObjectKeyframes))
+    out.keyframes.push_back(
+        read_pose_key(k, out.name, position, rotation_deg, out.keyframes.empty() ? nullptr : &out.keyframes.back()));
+  if (out.keyframes.empty()) return;
+  const SE3& first = out.keyframes.front().T_world_object;
+  const std::string why = fmt::format("(object \"{}\" stands at its first key's pose before that key; leave it out "
+                                      "or make them equal)",
+                                      out.name);
+  if (s.has("position") && norm(first.translation() - position) > kPoseMatchM)
+    s.fail("position", fmt::format("the first keyframe's position {} {}", show(first.translation()), why), show(position));
+  if (s.has("rotation_deg") && rotation_angle_between(first, out.T_world_object) > kPoseMatchRad)
+    s.fail("rotation_deg",
+           fmt::format("the first keyframe's rotation ({:.6g} degrees from this one) {}",
+                       rotation_angle_between(first, out.T_world_object) / kRadiansPerDegree, why),
+           show(rotation_deg));
+  out.T_world_object = first;
+}
+
 SimObject read_object(const TomlSection& s, size_t index) {
   SimObject out;
   out.name = s.string("name", fmt::format("object{}", index));
@@ -491,6 +548,7 @@ SimObject read_object(const TomlSection& s, size_t index) {
   const Vec3 position = s.vec3("position", {0, 0, 0});
   const Vec3 rotation_deg = s.vec3("rotation_deg", {0, 0, 0});
   out.T_world_object = SE3::from_rt(kRadiansPerDegree * rotation_deg, position);
+  read_pose_track(s, out, position, rotation_deg);
   out.is_virtual = s.boolean("virtual", out.is_virtual);
   out.casts_shadows = s.boolean("casts_shadows", out.casts_shadows);
 

@@ -182,6 +182,42 @@ void render_frame(const FrameRenderer& renderer, const SimCamera& camera, const 
   out.height = camera.frame_height();
 }
 
+// The shaders a frame is rendered with: the camera's world (real objects) and, when the scene
+// has virtual objects, the composite's (all of them). A static one is built once; one whose
+// objects move is placed anew at each frame's exposure start (objects do not move within an
+// exposure). Built here first (at trajectory time 0, the first frame's), so that a bad asset
+// throws before anything is written.
+class FrameWorlds {
+ public:
+  explicit FrameWorlds(const SimScene& scene)
+      : scene_(scene), animated_(scene.has_animated_objects()), with_virtual_(scene.has_virtual_objects()) {
+    build(animated_ ? scene_at_time(scene, posed_at_s_) : scene);
+  }
+  // Places the objects at trajectory time t_s (a no-op for a static scene).
+  void pose(double t_s) {
+    if (!animated_ || t_s == posed_at_s_) return;
+    camera_.reset();  // one Embree scene at a time
+    composite_.reset();
+    build(scene_at_time(scene_, t_s));
+    posed_at_s_ = t_s;
+  }
+  bool has_composite() const { return with_virtual_; }
+  const SceneShader& camera() const { return *camera_; }
+  const SceneShader& composite() const { return *composite_; }
+
+ private:
+  void build(const SimScene& posed) {
+    camera_.emplace(posed, false);
+    if (has_composite()) composite_.emplace(posed, true);
+  }
+
+  const SimScene& scene_;
+  bool animated_;
+  bool with_virtual_;
+  double posed_at_s_ = 0;
+  std::optional<SceneShader> camera_, composite_;
+};
+
 }  // namespace
 
 SimulateSummary simulate(const SimScene& scene, const SimulateOptions& options) {
@@ -213,9 +249,7 @@ SimulateSummary simulate(const SimScene& scene, const SimulateOptions& options) 
   const LensOptics optics(camera.optics, rays, camera.model.width(), camera.model.height());
   const FrameRenderer renderer(rays, camera.model.width(), camera.model.height(), scene.render.samples_per_pixel, seed,
                                options.threads);
-  const SceneShader camera_world(scene, false);
-  std::optional<SceneShader> composite_world;
-  if (scene.has_virtual_objects()) composite_world.emplace(scene, true);
+  FrameWorlds worlds(scene);  // a moving world is placed again for each frame (FrameWorlds::pose)
 
   const std::string source = options.source_description.empty()
                                  ? fmt::format("arpipe simulate {} (seed {})", scene.source_file.string(), seed)
@@ -224,7 +258,7 @@ SimulateSummary simulate(const SimScene& scene, const SimulateOptions& options) 
                                                         source, ""},
                          recorded_model);
   std::optional<RecordingWriter> composite_writer, coverage_writer;
-  if (composite_world) {
+  if (worlds.has_composite()) {
     composite_writer.emplace(options.out_dir / kGroundTruthCompositeDir,
                              RecordingInfo{kRecordingFormatVersion, PixelFormat::RGB24, width, height, 0,
                                            source + ": ground-truth composite", ""},
@@ -252,7 +286,8 @@ SimulateSummary simulate(const SimScene& scene, const SimulateOptions& options) 
     const double start_s = trajectory_time_s(camera, meta.exposure_start_ns);
 
     const ShutterPoseTable poses(trajectory, start_s, start_s + (meta.exposure_ns + meta.readout_ns) * 1e-9);
-    render_frame(renderer, camera, camera_world, poses, meta, start_s, index, optics, radiance, nullptr);
+    worlds.pose(start_s);
+    render_frame(renderer, camera, worlds.camera(), poses, meta, start_s, index, optics, radiance, nullptr);
     GroundTruthFrame truth = ground_truth(scene, trajectory, meta, lights);
     if (scene.render.write_linear) {
       truth.linear_image = fmt::format("linear_{:06d}.pfm", k);
@@ -270,8 +305,8 @@ SimulateSummary simulate(const SimScene& scene, const SimulateOptions& options) 
       frame.meta.raw.gains = std::array<double, 3>{1, 1, 1};
     }
     writer.append(frame, truth);
-    if (composite_world) {
-      render_frame(renderer, camera, *composite_world, poses, meta, start_s, index, optics, composite_radiance,
+    if (worlds.has_composite()) {
+      render_frame(renderer, camera, worlds.composite(), poses, meta, start_s, index, optics, composite_radiance,
                    &coverage);
       composite_writer->append(
           to_frame(expose(composite_radiance, sensor, exposure, seed, index), width, height, PixelFormat::RGB24, meta,
@@ -290,7 +325,7 @@ SimulateSummary simulate(const SimScene& scene, const SimulateOptions& options) 
   summary.frames = frames;
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   summary.setup_seconds = setup_seconds;
-  summary.wrote_composite = composite_world.has_value();
+  summary.wrote_composite = worlds.has_composite();
   return summary;
 }
 

@@ -37,10 +37,15 @@ struct SimulateOptions {
 struct SimulateSummary {
   int frames = 0;
   double seconds = 0;          // wall time in all
-  double setup_seconds = 0;    // of which loading assets, building the Embree scenes and the ray grid
+  // Of which loading assets, building the Embree scenes and the ray grid (a scene with moving
+  // objects builds its scenes again for each frame after the first: not counted here).
+  double setup_seconds = 0;
   bool wrote_composite = false;  // and the coverage beside it
 };
 
+// Objects with a pose track (SimObject::keyframes) stand, in each frame, where object_pose_at puts
+// them at that frame's exposure start (trajectory time): frame k of a video at its fps at k / fps.
+// Their motion within an exposure is not rendered (no motion blur of objects).
 // Throws AssetError (a scene asset), RecordingError (writing), std::invalid_argument (options, or a
 // frame over kMaxFrameSide / kMaxFramePixels).
 // Frames written before an error stay readable.
