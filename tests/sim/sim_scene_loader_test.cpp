@@ -135,7 +135,7 @@ const char* kTriangleGltf = R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"
 
 TEST(SimSceneLoaderExamples, EveryExampleLoadsAndSaysWhatItIsFor) {
   const std::set<std::string> expected{"blur-bench.toml", "calib-board.toml", "calib-board-photo.toml", "calib-charuco.toml", "default.toml", "probe-indoor.toml", "rolling-shutter.toml",
-                                       "proxies.toml", "proxies-panorama.toml", "courtyard.toml", "sun-outdoor.toml",
+                                       "proxies.toml", "proxies-panorama.toml", "hybrid-animated.toml", "courtyard.toml", "sun-outdoor.toml",
                                        "tag-pan.toml", "tag-static.toml"};
   std::set<std::string> found;
   for (const auto& entry : fs::directory_iterator(kScenes)) {
@@ -151,7 +151,8 @@ TEST(SimSceneLoaderExamples, EveryExampleLoadsAndSaysWhatItIsFor) {
     std::string first;
     std::getline(in, first);
     EXPECT_EQ(first.rfind("# ", 0), 0u) << first;
-    if (entry.path().filename() == "proxies-panorama.toml" || entry.path().filename() == "courtyard.toml") {
+    if (entry.path().filename() == "proxies-panorama.toml" || entry.path().filename() == "courtyard.toml" ||
+        entry.path().filename() == "hybrid-animated.toml") {
       // A panorama: the whole sphere in the equirectangular layout (fx = W / 2 pi, fy = H / pi, centred).
       const CameraModel& m = scene.camera.model;
       EXPECT_EQ(m.lensmodel(), "LENSMODEL_LONLAT");
