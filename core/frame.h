@@ -58,6 +58,7 @@ struct FrameMetadata {
   // each time step gives the left eye's frame, then the right's, with the same times); the renderer
   // then draws through that eye's omnidirectional-stereo geometry (core/geometry/ods_projection.h).
   Eye eye = Eye::Mono;
+  OdsRig ods;  // a stereo eye's capture geometry (source.panorama's ipd and pole merge)
   // The whole light around the camera, when the source holds it (a panorama, which is its own
   // environment): radiance SH in the world frame, scene-linear (light.source = "panorama").
   std::optional<ShRgb9> environment_sh;

@@ -150,6 +150,7 @@ SourceStatus PanoramaSource::next(Frame& frame) {
     frame.meta.source_frame_time_ns = place.frame_time_ns();
     frame.meta.viewpoint = int(s.here);
     frame.meta.eye = eye;
+    frame.meta.ods = panorama.ods_rig();
     frame.meta.environment_sh = place.light_sh();
     uint64_t skipped = 0;
     for (const PanoramaPlace& p : s.places) skipped += p.skipped_video_frames();

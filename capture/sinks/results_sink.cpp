@@ -56,9 +56,14 @@ nlohmann::json ResultsSink::to_json(const FrameContext& ctx) {
     // Where the anchor (world origin, where the virtual object stands) lands in the output image
     // (undistorted when render.lens is "undistort").
     const auto& model = ctx.output_camera_model ? ctx.output_camera_model : ctx.camera_model;
+    // A stereo panorama's eye sees it where that eye's capture holds it (ods_projection.h), as
+    // the render stage draws it.
     if (model) {
-      if (auto px = model->project(ctx.pose.T_cam_world * Vec3{0, 0, 0}))
-        j["anchor_px"] = {(*px)[0], (*px)[1]};
+      Vec3 anchor = ctx.pose.T_cam_world * Vec3{0, 0, 0};
+      if (ctx.camera.meta.eye != Eye::Mono)
+        anchor = ods_eye_point(ctx.camera.meta.ods, ctx.camera.meta.eye,
+                               mat_mul(ctx.pose.T_cam_world.rotation(), Vec3{0, 0, 1}), anchor);
+      if (auto px = model->project(anchor)) j["anchor_px"] = {(*px)[0], (*px)[1]};
     }
   }
   json motion = {{"state", std::string(motion_state_name(ctx.motion.state))}};

@@ -448,6 +448,37 @@ TEST(ResultsSink, WritesOneJsonLinePerFrameWithPoseAnchorPixelTimingsAndSkips) {
   EXPECT_FALSE(lines[2].contains("anchor_px"));
 }
 
+TEST(ResultsSink, AStereoEyesAnchorPixelIsWhereThatEyeSeesIt) {
+  // The anchor 0.5 m straight ahead on the horizon, seen from a stereo panorama's eyes 64 mm apart:
+  // each eye's ray to it leaves the eye circle tangentially, so the left eye sees it at
+  // f r / sqrt(D^2 - r^2) right of the centre (r = 32 mm, sin of the angle r / D) and the right eye
+  // as far left, where the render stage draws it (ods_projection.h); a mono frame at the centre.
+  const fs::path file = scratch_dir("results-stereo") / "results.jsonl";
+  auto camera = std::make_shared<const CameraModel>(CameraModel::pinhole(500, 500, 319.5, 239.5, 640, 480));
+  const double distance = 0.5, r = 0.032;
+  // Camera x = world x, camera y = -world z (down), camera z = world y (ahead).
+  const Mat3 R_cam_world{{{1, 0, 0}, {0, 0, -1}, {0, 1, 0}}};
+  ResultsSink sink(ResultsSinkConfig{true, file});
+  for (const Eye eye : {Eye::Left, Eye::Right, Eye::Mono}) {
+    FrameContext ctx;
+    ctx.camera_model = camera;
+    ctx.pose.state = TrackState::Tracking;
+    ctx.pose.T_cam_world = SE3(R_cam_world, {0, 0, distance});
+    ctx.camera.meta.eye = eye;
+    ctx.camera.meta.ods.ipd_m = 2 * r;
+    sink.consume(ctx);
+  }
+  sink.flush();
+  const auto lines = read_json_lines(file);
+  ASSERT_EQ(lines.size(), 3u);
+  const double offset = 500 * r / std::sqrt(distance * distance - r * r);
+  for (const auto& [line, expected_x] : {std::pair{0, 319.5 + offset}, std::pair{1, 319.5 - offset}, std::pair{2, 319.5}}) {
+    ASSERT_TRUE(lines[size_t(line)].contains("anchor_px")) << line;
+    EXPECT_NEAR(lines[size_t(line)].at("anchor_px")[0].get<double>(), expected_x, 1e-6) << "line " << line;
+    EXPECT_NEAR(lines[size_t(line)].at("anchor_px")[1].get<double>(), 239.5, 1e-6) << "line " << line;
+  }
+}
+
 TEST(ResultsSink, WriteFailureIsLoggedNotThrown) {
   ResultsSink sink(ResultsSinkConfig{true, "/dev/full"});
   FrameContext ctx;
