@@ -33,7 +33,9 @@ class GltfAnimation {
   // channel whose node does not exist, a sampler index out of range, input times not finite,
   // negative or not strictly increasing, output values not finite or not as many as the input's
   // (three times as many for CUBICSPLINE), a rotation key of zero length, counts past
-  // gltf_limits.h. Channels of path "weights" (morph targets) are ignored.
+  // gltf_limits.h, a channel on a node with a matrix (glTF forbids it), two channels on one
+  // node's one property, two animations of the name asked for. Channels of path "weights" (morph
+  // targets) are ignored.
   static GltfAnimation load(const std::filesystem::path& path, std::string_view animation = "");
 
   const std::string& name() const;  // the animation's, "" when it has none
@@ -42,7 +44,8 @@ class GltfAnimation {
   // The node of that name in the scene load_gltf_mesh walks; nullopt when there is none. Throws
   // AssetError when two nodes carry the name (glTF does not make names unique).
   std::optional<int> find_node(std::string_view name) const;
-  // Whether this animation moves the node or one of its ancestors.
+  // Whether this animation moves the node or one of its ancestors (a translation, rotation or
+  // scale channel on it). AssetError for a node index not in the scene.
   bool moves(int node) const;
   // The node's global transform at time t (seconds; before the first key and after the last the
   // end keys hold, as glTF says), in the z-up frame: N = C G(t) C^-1, where G is glTF's product of
@@ -50,9 +53,13 @@ class GltfAnimation {
   // (gltf_loader.h). A mesh loaded in the node's own frame (GltfMeshSelection::node) placed at N
   // lands where load_gltf_mesh puts the whole scene's copy of it. Throws AssetError naming the node
   // when its global transform is not a rotation, a translation and a uniform scale (a shear or a
-  // non-uniform scale on it or an ancestor, at rest or in a key).
+  // non-uniform scale on it or an ancestor, at rest or in a key; a mirror): each entry of L^T L / s^2
+  // (L its linear part, s^2 the mean of L^T L's diagonal) within 1e-6 of the identity's. A zero
+  // scale gives scale 0 and the identity rotation. AssetError too for a node index not in the
+  // scene; std::invalid_argument for a time that is not a number (+-infinity: the end keys).
   ScaledPose node_pose_at(int node, double t_s) const;
-  // The file's lights (as load_gltf_lights) with their nodes posed at time t.
+  // The file's lights (as load_gltf_lights: the same records, in the same order) with their nodes
+  // posed at time t.
   std::vector<GltfLight> lights_at(double t_s) const;
 
   GltfAnimation(GltfAnimation&&) noexcept;

@@ -157,7 +157,7 @@ class DocumentReader {
     if (!gltf.is_object())
       fail(fmt::format("not a valid glTF 2.0 {} file: the JSON is not an object",
                        document_.binary ? "binary (.glb)" : "JSON"));
-    for (const char* unused : {"images", "textures", "samplers", "animations", "skins", "cameras"}) gltf.erase(unused);
+    for (const char* unused : {"images", "textures", "samplers", "skins", "cameras"}) gltf.erase(unused);
     const PunctualLights lights = take_punctual_lights(gltf);
     drop_extras_and_extensions(gltf);
     put_punctual_lights(gltf, lights);
@@ -175,8 +175,103 @@ class DocumentReader {
           fail(fmt::format("mesh {} has {} primitives, over the limit of {}", m, primitives->size(),
                            kMaxGltfArrayEntries));
       }
+    check_animations(gltf);
     check_buffers(gltf);
     return gltf.dump();
+  }
+
+  static std::string shown(const json& value) {
+    std::string text = value.dump();
+    return text.size() > 60 ? text.substr(0, 60) + "..." : text;
+  }
+
+  static size_t array_size(const json& gltf, const char* name) {
+    const auto it = gltf.find(name);
+    return it != gltf.end() && it->is_array() ? it->size() : 0;
+  }
+
+  // An integer index into an array of `count` entries.
+  static bool is_index(const json& value, size_t count) {
+    return value.is_number_integer() && value.get<int64_t>() >= 0 && uint64_t(value.get<int64_t>()) < count;
+  }
+
+  // "animations" (GltfAnimation reads them): counts within gltf_limits.h, every index an integer
+  // in range, interpolation and path among glTF's. Checked here so that tinygltf, which drops a
+  // channel it cannot parse and so renumbers the rest, parses each one.
+  void check_animations(json& gltf) const {
+    const auto animations = gltf.find("animations");
+    if (animations == gltf.end()) return;
+    if (!animations->is_array()) fail("\"animations\" is not an array");
+    if (animations->size() > kMaxGltfAnimations)
+      fail(fmt::format("\"animations\" has {} entries, over the limit of {}", animations->size(), kMaxGltfAnimations));
+    const size_t nodes = array_size(gltf, "nodes"), accessors = array_size(gltf, "accessors");
+    for (size_t a = 0; a < animations->size(); ++a) {
+      json& animation = (*animations)[a];
+      const std::string where = fmt::format("animation {}", a);
+      if (!animation.is_object()) fail(where + ": not an object");
+      if (const auto name = animation.find("name"); name != animation.end() && !name->is_string())
+        fail(fmt::format("{}: \"name\" must be a string, not {}", where, shown(*name)));
+      const size_t samplers = check_animation_samplers(animation, where, accessors);
+      check_animation_channels(animation, where, samplers, nodes);
+    }
+  }
+
+  // The animation's samplers; their count.
+  size_t check_animation_samplers(const json& animation, const std::string& where, size_t accessors) const {
+    const auto samplers = animation.find("samplers");
+    if (samplers == animation.end() || !samplers->is_array()) fail(where + ": \"samplers\" must be an array");
+    if (samplers->size() > kMaxGltfAnimationSamplers)
+      fail(fmt::format("{}: {} samplers, over the limit of {}", where, samplers->size(), kMaxGltfAnimationSamplers));
+    for (size_t s = 0; s < samplers->size(); ++s) {
+      const json& sampler = (*samplers)[s];
+      const std::string at = fmt::format("{} sampler {}", where, s);
+      if (!sampler.is_object()) fail(at + ": not an object");
+      for (const char* key : {"input", "output"}) {
+        const auto index = sampler.find(key);
+        if (index == sampler.end() || !is_index(*index, accessors))
+          fail(fmt::format("{}: \"{}\" must be an accessor index below {} (the accessors), not {}", at, key, accessors,
+                           index == sampler.end() ? "missing" : shown(*index)));
+      }
+      if (const auto interpolation = sampler.find("interpolation"); interpolation != sampler.end())
+        if (*interpolation != "STEP" && *interpolation != "LINEAR" && *interpolation != "CUBICSPLINE")
+          fail(fmt::format("{}: \"interpolation\" must be \"STEP\", \"LINEAR\" or \"CUBICSPLINE\", not {}", at,
+                           shown(*interpolation)));
+    }
+    return samplers->size();
+  }
+
+  void check_animation_channels(json& animation, const std::string& where, size_t samplers, size_t nodes) const {
+    const auto channels = animation.find("channels");
+    if (channels == animation.end() || !channels->is_array()) fail(where + ": \"channels\" must be an array");
+    if (channels->size() > kMaxGltfAnimationChannels)
+      fail(fmt::format("{}: {} channels, over the limit of {}", where, channels->size(), kMaxGltfAnimationChannels));
+    for (size_t c = 0; c < channels->size(); ++c) {
+      json& channel = (*channels)[c];
+      const std::string at = fmt::format("{} channel {}", where, c);
+      if (!channel.is_object()) fail(at + ": not an object");
+      const auto sampler = channel.find("sampler");
+      if (sampler == channel.end() || !is_index(*sampler, samplers))
+        fail(fmt::format("{}: \"sampler\" must be an index below {} (the animation's samplers), not {}", at, samplers,
+                         sampler == channel.end() ? "missing" : shown(*sampler)));
+      const auto target = channel.find("target");
+      if (target == channel.end() || !target->is_object()) fail(at + ": \"target\" must be an object");
+      const auto node = target->find("node");
+      if (node == target->end()) {
+        // glTF: a channel without a node (an extension's target) is ignored. It stays, as a
+        // "weights" channel (ignored too), so that the channels after it keep their indices;
+        // without nodes every channel is such a one, and none stays.
+        *target = {{"node", 0}, {"path", "weights"}};
+        continue;
+      }
+      if (!is_index(*node, nodes))
+        fail(fmt::format("{}: target \"node\" must be a node index below {} (the nodes), not {}", at, nodes, shown(*node)));
+      const auto path = target->find("path");
+      if (path == target->end() ||
+          (*path != "translation" && *path != "rotation" && *path != "scale" && *path != "weights"))
+        fail(fmt::format("{}: target \"path\" must be \"translation\", \"rotation\", \"scale\" or \"weights\", not {}",
+                         at, path == target->end() ? "missing" : shown(*path)));
+    }
+    if (nodes == 0) *channels = json::array();
   }
 
   // KHR_lights_punctual is the one extension kept (the scene's lights, load_gltf_lights): checked

@@ -27,6 +27,17 @@ inline constexpr size_t kMaxGltfNodeDepth = 1024;
 // The one mesh the loader returns (every node's instance of a mesh counts again).
 inline constexpr size_t kMaxGltfTriangles = 4'000'000;
 inline constexpr size_t kMaxGltfVertices = 12'000'000;
+// Animations ("animations": an array of its own, under kMaxGltfArrayEntries too), and each one's
+// channels and samplers: a rig of 20,000 moving nodes with three channels each fits.
+inline constexpr size_t kMaxGltfAnimations = 4096;
+inline constexpr size_t kMaxGltfAnimationChannels = 65'536;
+inline constexpr size_t kMaxGltfAnimationSamplers = 65'536;
+// Keys of one sampler (its input accessor's elements; a CUBICSPLINE output holds three per key):
+// over four hours at 60 keys a second.
+inline constexpr size_t kMaxGltfAnimationKeys = 1'000'000;
+// Accessor elements one GltfAnimation::load reads (each accessor once, however many samplers share
+// it): kept as floats, at most 16 bytes an element, so 256 MiB at the limit.
+inline constexpr uint64_t kMaxGltfAnimationElementsRead = 16'000'000;
 // Accessor elements read over the whole load: a mesh instanced by many nodes is read once per
 // node, so this bounds the work even for primitives that add no triangles.
 inline constexpr uint64_t kMaxGltfElementsRead = 64'000'000;

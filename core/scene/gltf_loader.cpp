@@ -10,6 +10,8 @@
 #define TINYGLTF_NO_STB_IMAGE_WRITE
 #define TINYGLTF_NO_EXTERNAL_IMAGE
 #include <tiny_gltf.h>
+// Compiled once: a unity batch's later files (gltf_model.h among them) see only the declarations.
+#undef TINYGLTF_IMPLEMENTATION
 
 #include <fmt/format.h>
 
@@ -28,8 +30,10 @@
 #include "core/log.h"
 #include "core/scene/asset_error.h"
 #include "core/scene/asset_file.h"
+#include "core/scene/gltf_animation.h"
 #include "core/scene/gltf_document.h"
 #include "core/scene/gltf_limits.h"
+#include "core/scene/gltf_model.h"
 
 namespace arpipe {
 namespace {
@@ -115,55 +119,40 @@ bool all_finite(const glm::dmat3& m) {
   return true;
 }
 
-// glTF's y-up axes to arpipe's z-up object frame: +y (up) becomes +z, +z (the model's front) -y.
-glm::dvec3 to_object_frame(const glm::dvec3& v) { return glm::dvec3(v.x, -v.z, v.y); }
-
 class GltfMeshCollector {
  public:
   // read_meshes false: only the lights are collected (load_gltf_lights).
   GltfMeshCollector(const tinygltf::Model& model, const std::filesystem::path& path, bool read_meshes = true)
-      : model_(model), path_(path), reached_(model.nodes.size(), false), read_meshes_(read_meshes) {}
+      : model_(model), path_(path), read_meshes_(read_meshes) {}
 
   std::vector<GltfLight> take_lights() { return std::move(lights_); }
 
-  // The node hierarchy under `roots`, walked depth-first with an explicit stack (no recursion over
-  // the file's graph). glTF nodes form strict trees: a node reached a second time (two parents,
-  // a cycle, a scene root that is also a child) is an error, so every node is visited at most once.
-  void add_roots(const std::vector<int>& roots) {
-    struct Pending {
-      int node;
-      glm::dmat4 parent;
-      size_t depth;
-    };
-    std::vector<Pending> stack;
-    for (auto root = roots.rbegin(); root != roots.rend(); ++root) stack.push_back({*root, glm::dmat4(1.0), 1});
-    while (!stack.empty()) {
-      const Pending pending = stack.back();
-      stack.pop_back();
-      const int node_index = pending.node;
-      if (node_index < 0 || static_cast<size_t>(node_index) >= model_.nodes.size())
-        fail(fmt::format("node {} does not exist ({} nodes)", node_index, model_.nodes.size()));
-      if (reached_[static_cast<size_t>(node_index)])
-        fail(fmt::format("node {} is reached more than once: it has more than one parent, is its own ancestor or "
-                         "is both a scene root and a child (glTF nodes form strict trees)",
-                         node_index));
-      reached_[static_cast<size_t>(node_index)] = true;
-      if (pending.depth > kMaxGltfNodeDepth)
-        fail(fmt::format("node {} is {} levels deep in the node hierarchy, over the depth limit of {}", node_index,
-                         pending.depth, kMaxGltfNodeDepth));
-      const tinygltf::Node& node = model_.nodes[static_cast<size_t>(node_index)];
-      const glm::dmat4 transform = pending.parent * node_transform(node_index, node);
-      if (!all_finite(transform))
-        fail(fmt::format("node {}: its transform combined with its parents' is not finite (overflow)", node_index));
-      if (node.mesh >= 0 && read_meshes_) add_mesh(node_index, node.mesh, transform);
-      add_light(node_index, node, transform);
-      for (auto child = node.children.rbegin(); child != node.children.rend(); ++child)
-        stack.push_back({*child, transform, pending.depth + 1});
-    }
+  // The meshes (and lights) of the nodes under `roots` (gltf::walk_nodes: a strict tree within
+  // the depth limit). skip: per node, leave its subtree out. frame_node: a node whose own global
+  // transform is left out (its subtree in its own frame).
+  void add_roots(const std::vector<int>& roots, const std::vector<bool>* skip = nullptr, int frame_node = -1) {
+    gltf::walk_nodes(model_, path_, roots, glm::dmat4(1.0),
+                     [&](int node_index, const glm::dmat4& parent) -> std::optional<glm::dmat4> {
+                       if (skip != nullptr && (*skip)[static_cast<size_t>(node_index)]) return std::nullopt;
+                       const tinygltf::Node& node = model_.nodes[static_cast<size_t>(node_index)];
+                       const glm::dmat4 transform =
+                           node_index == frame_node ? glm::dmat4(1.0)
+                                                    : parent * gltf::rest_transform(model_, path_, node_index);
+                       if (!all_finite(transform))
+                         fail(fmt::format("node {}: its transform combined with its parents' is not finite (overflow)",
+                                          node_index));
+                       if (node.mesh >= 0 && read_meshes_) add_mesh(node_index, node.mesh, transform);
+                       if (std::optional<GltfLight> light = gltf::placed_light(model_, path_, node_index, transform))
+                         lights_.push_back(std::move(*light));
+                       return transform;
+                     });
   }
 
-  Mesh finish() {
-    if (mesh_.indices.empty()) fail("contains no triangles (no mesh with a TRIANGLES, TRIANGLE_STRIP or TRIANGLE_FAN primitive in the scene)");
+  // `taken`: what of the file was loaded, for the message when it holds no triangles.
+  Mesh finish(const std::string& taken = "the scene") {
+    if (mesh_.indices.empty())
+      fail(fmt::format("contains no triangles (no mesh with a TRIANGLES, TRIANGLE_STRIP or TRIANGLE_FAN primitive in {})",
+                       taken));
     if (skipped_primitives_ > 0)
       log::warn("{}: skipped {} primitive(s) that are points or lines", path_.string(), skipped_primitives_);
     if (skipped_singular_ > 0)
@@ -174,47 +163,7 @@ class GltfMeshCollector {
   }
 
  private:
-  [[noreturn]] void fail(const std::string& what) const { throw AssetError(fmt::format("{}: {}", path_.string(), what)); }
-
-  glm::dmat4 node_transform(int node_index, const tinygltf::Node& node) const {
-    for (const auto* values : {&node.matrix, &node.translation, &node.rotation, &node.scale})
-      if (!all_finite(*values)) fail(fmt::format("node {}: its matrix or TRS has a value that is not finite", node_index));
-    if (node.matrix.size() == 16) return glm::make_mat4(node.matrix.data());  // column-major, as glTF stores it
-    glm::dmat4 transform(1.0);
-    if (node.translation.size() == 3)
-      transform = glm::translate(transform, glm::dvec3(node.translation[0], node.translation[1], node.translation[2]));
-    if (node.rotation.size() == 4)  // glTF quaternions are x, y, z, w; glm's constructor takes w first
-      transform *= glm::mat4_cast(glm::dquat(node.rotation[3], node.rotation[0], node.rotation[1], node.rotation[2]));
-    if (node.scale.size() == 3) transform = glm::scale(transform, glm::dvec3(node.scale[0], node.scale[1], node.scale[2]));
-    return transform;
-  }
-
-  // The node's KHR_lights_punctual light (gltf_document.cpp checked its index), placed: at the
-  // node's origin, shining along its -z, in the z-up frame.
-  void add_light(int node_index, const tinygltf::Node& node, const glm::dmat4& transform) {
-    const auto extension = node.extensions.find("KHR_lights_punctual");
-    if (extension == node.extensions.end() || !extension->second.Has("light")) return;
-    const int index = extension->second.Get("light").GetNumberAsInt();
-    if (index < 0 || static_cast<size_t>(index) >= model_.lights.size())
-      fail(fmt::format("node {} names light {}, which does not exist", node_index, index));
-    const tinygltf::Light& light = model_.lights[static_cast<size_t>(index)];
-    const glm::dvec3 position = to_object_frame(glm::dvec3(transform * glm::dvec4(0, 0, 0, 1)));
-    glm::dvec3 direction = to_object_frame(glm::dmat3(transform) * glm::dvec3(0, 0, -1));
-    const double length = glm::length(direction);
-    if (!(length > 1e-100) || !std::isfinite(length) || !std::isfinite(position.x + position.y + position.z))
-      fail(fmt::format("node {}: light {} has no direction or position (a zero or infinite scale)", node_index, index));
-    direction /= length;
-    GltfLight out;
-    out.name = light.name;
-    out.type = light.type;
-    if (light.color.size() == 3) out.color = {light.color[0], light.color[1], light.color[2]};
-    out.intensity = light.intensity;
-    out.range = light.range;
-    out.position = {position.x, position.y, position.z};
-    out.direction = {direction.x, direction.y, direction.z};
-    out.node = node_index;
-    lights_.push_back(std::move(out));
-  }
+  [[noreturn]] void fail(const std::string& what) const { gltf::fail(path_, what); }
 
   void add_mesh(int node_index, int mesh_index, const glm::dmat4& transform) {
     if (static_cast<size_t>(mesh_index) >= model_.meshes.size())
@@ -229,83 +178,26 @@ class GltfMeshCollector {
       add_primitive(node_index, mesh_index, p, mesh.primitives[p], transform, normal_matrix);
   }
 
-  // An accessor's elements: where the first starts, the byte step to the next, how many.
-  struct Span {
-    const unsigned char* data;
-    size_t stride;
-    size_t count;
-  };
-
-  const tinygltf::Accessor& checked_accessor(int accessor_index, const std::string& where) const {
-    if (accessor_index < 0 || static_cast<size_t>(accessor_index) >= model_.accessors.size())
-      fail(fmt::format("{}: accessor {} does not exist ({} accessors)", where, accessor_index, model_.accessors.size()));
-    const tinygltf::Accessor& accessor = model_.accessors[static_cast<size_t>(accessor_index)];
-    if (accessor.sparse.isSparse) fail(fmt::format("{}: accessor {} is sparse, which is not supported", where, accessor_index));
-    return accessor;
-  }
-
-  // Checks, with overflow-checked arithmetic, that every element lies inside the accessor's buffer
-  // view and the view inside its buffer, and that the count is within `max_count`: all before any
-  // element is read or any memory is allocated for them.
-  Span element_span(const tinygltf::Accessor& accessor, int accessor_index, const std::string& where,
-                    size_t element_size, size_t max_count, const char* limit_name) const {
-    if (accessor.bufferView < 0 || static_cast<size_t>(accessor.bufferView) >= model_.bufferViews.size())
-      fail(fmt::format("{}: accessor {} has no valid bufferView ({})", where, accessor_index, accessor.bufferView));
-    const tinygltf::BufferView& view = model_.bufferViews[static_cast<size_t>(accessor.bufferView)];
-    if (view.buffer < 0 || static_cast<size_t>(view.buffer) >= model_.buffers.size())
-      fail(fmt::format("{}: bufferView {} names buffer {}, which does not exist", where, accessor.bufferView, view.buffer));
-    const tinygltf::Buffer& buffer = model_.buffers[static_cast<size_t>(view.buffer)];
-    size_t view_end = 0;
-    if (__builtin_add_overflow(view.byteOffset, view.byteLength, &view_end) || view_end > buffer.data.size())
-      fail(fmt::format("{}: bufferView {} (byteOffset {}, byteLength {}) runs past the end of buffer {} ({} bytes)",
-                       where, accessor.bufferView, view.byteOffset, view.byteLength, view.buffer, buffer.data.size()));
-    // glTF: byteStride is 4..252 and a multiple of 4 (tinygltf checks it too); 0 means packed.
-    if (view.byteStride != 0 && (view.byteStride < 4 || view.byteStride > 252 || view.byteStride % 4 != 0))
-      fail(fmt::format("{}: bufferView {} has byteStride {} (must be 4 to 252, a multiple of 4)", where,
-                       accessor.bufferView, view.byteStride));
-    const int stride = accessor.ByteStride(view);
-    if (stride <= 0 || static_cast<size_t>(stride) < element_size)
-      fail(fmt::format("{}: accessor {} has an invalid byte stride {} for {}-byte elements (bufferView {})", where,
-                       accessor_index, stride, element_size, accessor.bufferView));
-    if (accessor.count > 0) {
-      size_t last_start = 0, end = 0;
-      if (__builtin_mul_overflow(static_cast<size_t>(stride), accessor.count - 1, &last_start) ||
-          __builtin_add_overflow(last_start, accessor.byteOffset, &last_start) ||
-          __builtin_add_overflow(last_start, element_size, &end) || end > view.byteLength)
-        fail(fmt::format("{}: accessor {} ({} elements of {} bytes, stride {}, from byteOffset {}) does not fit in "
-                         "bufferView {} ({} bytes)",
-                         where, accessor_index, accessor.count, element_size, stride, accessor.byteOffset,
-                         accessor.bufferView, view.byteLength));
-    }
-    if (accessor.count > max_count)
-      fail(fmt::format("{}: accessor {} has {} elements, over the limit of {} {}", where, accessor_index,
-                       accessor.count, max_count, limit_name));
-    return {buffer.data.data() + view.byteOffset + accessor.byteOffset, static_cast<size_t>(stride), accessor.count};
-  }
+  using Span = gltf::AccessorSpan;
 
   Span vec3_span(int accessor_index, const std::string& where) const {
-    const tinygltf::Accessor& accessor = checked_accessor(accessor_index, where);
+    const tinygltf::Accessor& accessor = reader_.accessor(accessor_index, where);
     if (accessor.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT || accessor.type != TINYGLTF_TYPE_VEC3)
       fail(fmt::format("{}: accessor {} must be VEC3 of FLOAT", where, accessor_index));
-    return element_span(accessor, accessor_index, where, 12, kMaxGltfVertices, "vertices");
+    return reader_.span(accessor, accessor_index, where, 12, kMaxGltfVertices, "vertices");
   }
 
   // The span's VEC3 FLOAT elements, each finite.
   std::vector<glm::dvec3> read_vec3(const Span& span, int accessor_index, const std::string& where) const {
+    const tinygltf::Accessor& accessor = reader_.accessor(accessor_index, where);
+    const std::vector<float> xyz = reader_.read_floats(span, accessor, accessor_index, where, 3);
     std::vector<glm::dvec3> values(span.count);
-    for (size_t i = 0; i < span.count; ++i) {
-      float xyz[3];
-      std::memcpy(xyz, span.data + i * span.stride, sizeof(xyz));
-      if (!std::isfinite(xyz[0]) || !std::isfinite(xyz[1]) || !std::isfinite(xyz[2]))
-        fail(fmt::format("{}: accessor {} element {} is not finite ({}, {}, {})", where, accessor_index, i, xyz[0],
-                         xyz[1], xyz[2]));
-      values[i] = glm::dvec3(xyz[0], xyz[1], xyz[2]);
-    }
+    for (size_t i = 0; i < span.count; ++i) values[i] = glm::dvec3(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
     return values;
   }
 
   std::pair<Span, size_t> index_span(int accessor_index, const std::string& where) const {
-    const tinygltf::Accessor& accessor = checked_accessor(accessor_index, where);
+    const tinygltf::Accessor& accessor = reader_.accessor(accessor_index, where);
     size_t size = 0;
     switch (accessor.componentType) {
       case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: size = 1; break;
@@ -315,7 +207,7 @@ class GltfMeshCollector {
     }
     if (accessor.type != TINYGLTF_TYPE_SCALAR) fail(fmt::format("{}: index accessor {} must be SCALAR", where, accessor_index));
     // A strip or fan of n indices makes n - 2 triangles.
-    return {element_span(accessor, accessor_index, where, size, 3 * kMaxGltfTriangles + 2, "indices"), size};
+    return {reader_.span(accessor, accessor_index, where, size, 3 * kMaxGltfTriangles + 2, "indices"), size};
   }
 
   static std::vector<uint32_t> read_indices(const Span& span, size_t size) {
@@ -429,7 +321,7 @@ class GltfMeshCollector {
 
     // glTF is y-up with the model's front towards +z; the object frame is z-up (x stays x).
     auto place = [&](const glm::dvec3& position, size_t vertex) {
-      const glm::dvec3 placed = to_object_frame(glm::dvec3(transform * glm::dvec4(position, 1.0)));
+      const glm::dvec3 placed = gltf::to_object_frame(glm::dvec3(transform * glm::dvec4(position, 1.0)));
       for (int axis = 0; axis < 3; ++axis)
         if (!std::isfinite(static_cast<float>(placed[axis])))
           fail(fmt::format("node {} {}: vertex {} is ({}, {}, {}) after the node's transform, beyond float range",
@@ -449,7 +341,7 @@ class GltfMeshCollector {
         push(mesh_.positions, place(positions[i], i));
         glm::dvec3 n = normal_matrix * normals[i];
         if (glm::length(n) > 0) n = glm::normalize(n);
-        push(mesh_.normals, to_object_frame(n));
+        push(mesh_.normals, gltf::to_object_frame(n));
       }
       for (size_t i = 0; i < triangles.size(); i += 3) {
         const uint32_t a = base + triangles[i], b = base + triangles[i + 1], c = base + triangles[i + 2];
@@ -478,7 +370,7 @@ class GltfMeshCollector {
 
   const tinygltf::Model& model_;
   const std::filesystem::path& path_;
-  std::vector<bool> reached_;  // per node: already placed once
+  gltf::AccessorReader reader_{model_, path_};
   Mesh mesh_;
   bool read_meshes_ = true;
   std::vector<GltfLight> lights_;
@@ -487,9 +379,15 @@ class GltfMeshCollector {
   uint64_t elements_read_ = 0;
 };
 
-// The scene's root nodes: the default scene's, else the first scene's, else every node that is
-// nobody's child.
-std::vector<int> root_nodes(const tinygltf::Model& model) {
+}  // namespace
+
+namespace gltf {
+
+void fail(const std::filesystem::path& path, const std::string& what) {
+  throw AssetError(fmt::format("{}: {}", path.string(), what));
+}
+
+std::vector<int> scene_roots(const tinygltf::Model& model) {
   if (model.defaultScene >= 0 && static_cast<size_t>(model.defaultScene) < model.scenes.size())
     return model.scenes[static_cast<size_t>(model.defaultScene)].nodes;
   if (!model.scenes.empty()) return model.scenes.front().nodes;
@@ -503,7 +401,7 @@ std::vector<int> root_nodes(const tinygltf::Model& model) {
   return roots;
 }
 
-tinygltf::Model load_checked_gltf_model(const std::filesystem::path& path) {
+tinygltf::Model load_checked_model(const std::filesystem::path& path) {
   GltfDocument document = read_gltf_document(path);
   ExternalFiles external{document.folder, kMaxGltfBufferBytes};
   tinygltf::TinyGLTF loader;
@@ -527,37 +425,236 @@ tinygltf::Model load_checked_gltf_model(const std::filesystem::path& path) {
   return model;
 }
 
-// Every failure an AssetError naming the file: the limits above keep allocations small, and this is
-// the last line for what they do not foresee.
-template <class F>
-auto as_asset_errors(const std::filesystem::path& path, F load) {
-  try {
-    return load();
-  } catch (const AssetError&) {
-    throw;
-  } catch (const std::bad_alloc&) {
-    throw AssetError(fmt::format("{}: out of memory while loading the glTF file", path.string()));
-  } catch (const std::exception& e) {
-    throw AssetError(fmt::format("{}: cannot load the glTF file: {}", path.string(), e.what()));
+NodeTree scene_node_tree(const tinygltf::Model& model, const std::filesystem::path& path) {
+  NodeTree tree{{}, std::vector<int>(model.nodes.size(), -1), std::vector<bool>(model.nodes.size(), false)};
+  walk_nodes(model, path, scene_roots(model), -1, [&](int node, int parent) -> std::optional<int> {
+    tree.order.push_back(node);
+    tree.parent[static_cast<size_t>(node)] = parent;
+    tree.in_scene[static_cast<size_t>(node)] = true;
+    return node;
+  });
+  return tree;
+}
+
+std::optional<int> find_named_node(const tinygltf::Model& model, const NodeTree& tree,
+                                   const std::filesystem::path& path, std::string_view name) {
+  std::optional<int> found;
+  for (int node : tree.order) {
+    if (model.nodes[static_cast<size_t>(node)].name != name) continue;
+    if (found)
+      fail(path, fmt::format("nodes {} and {} are both named \"{}\" (a node must be named once to be chosen)", *found,
+                             node, name));
+    found = node;
   }
+  return found;
+}
+
+std::vector<bool> animated_nodes(const tinygltf::Model& model) {
+  std::vector<bool> animated(model.nodes.size(), false);
+  for (const tinygltf::Animation& animation : model.animations)
+    for (const tinygltf::AnimationChannel& channel : animation.channels)
+      if (channel.target_path != "weights" && channel.target_node >= 0 &&
+          static_cast<size_t>(channel.target_node) < animated.size())
+        animated[static_cast<size_t>(channel.target_node)] = true;
+  return animated;
+}
+
+std::string node_label(const tinygltf::Model& model, int node) {
+  const std::string& name = model.nodes[static_cast<size_t>(node)].name;
+  if (name.empty()) return fmt::format("node {}", node);
+  return fmt::format("node {} (\"{}\")", node, name.size() > 100 ? name.substr(0, 100) + "..." : name);
+}
+
+glm::dmat4 trs_transform(const glm::dvec3& translation, const glm::dquat& rotation, const glm::dvec3& scale) {
+  const double length = glm::length(rotation);
+  const glm::dquat unit = length > 0 && std::isfinite(length) ? rotation / length : rotation;
+  return glm::scale(glm::translate(glm::dmat4(1.0), translation) * glm::mat4_cast(unit), scale);
+}
+
+NodeTrs rest_trs(const tinygltf::Model& model, const std::filesystem::path& path, int node_index) {
+  const tinygltf::Node& node = model.nodes[static_cast<size_t>(node_index)];
+  for (const auto* values : {&node.matrix, &node.translation, &node.rotation, &node.scale})
+    if (!all_finite(*values)) fail(path, fmt::format("node {}: its matrix or TRS has a value that is not finite", node_index));
+  NodeTrs trs;
+  if (node.translation.size() == 3) trs.translation = {node.translation[0], node.translation[1], node.translation[2]};
+  // glTF quaternions are x, y, z, w; glm's constructor takes w first.
+  if (node.rotation.size() == 4) trs.rotation = {node.rotation[3], node.rotation[0], node.rotation[1], node.rotation[2]};
+  if (node.scale.size() == 3) trs.scale = {node.scale[0], node.scale[1], node.scale[2]};
+  return trs;
+}
+
+glm::dmat4 rest_transform(const tinygltf::Model& model, const std::filesystem::path& path, int node_index) {
+  const NodeTrs trs = rest_trs(model, path, node_index);
+  const tinygltf::Node& node = model.nodes[static_cast<size_t>(node_index)];
+  if (node.matrix.size() == 16) return glm::make_mat4(node.matrix.data());  // column-major, as glTF stores it
+  return trs_transform(trs.translation, trs.rotation, trs.scale);
+}
+
+std::optional<GltfLight> placed_light(const tinygltf::Model& model, const std::filesystem::path& path, int node_index,
+                                      const glm::dmat4& global) {
+  const tinygltf::Node& node = model.nodes[static_cast<size_t>(node_index)];
+  const auto extension = node.extensions.find("KHR_lights_punctual");
+  if (extension == node.extensions.end() || !extension->second.Has("light")) return std::nullopt;
+  const int index = extension->second.Get("light").GetNumberAsInt();
+  if (index < 0 || static_cast<size_t>(index) >= model.lights.size())
+    fail(path, fmt::format("node {} names light {}, which does not exist", node_index, index));
+  const tinygltf::Light& light = model.lights[static_cast<size_t>(index)];
+  const glm::dvec3 position = to_object_frame(glm::dvec3(global * glm::dvec4(0, 0, 0, 1)));
+  glm::dvec3 direction = to_object_frame(glm::dmat3(global) * glm::dvec3(0, 0, -1));
+  const double length = glm::length(direction);
+  if (!(length > 1e-100) || !std::isfinite(length) || !std::isfinite(position.x + position.y + position.z))
+    fail(path, fmt::format("node {}: light {} has no direction or position (a zero or infinite scale)", node_index, index));
+  direction /= length;
+  GltfLight out;
+  out.name = light.name;
+  out.type = light.type;
+  if (light.color.size() == 3) out.color = {light.color[0], light.color[1], light.color[2]};
+  out.intensity = light.intensity;
+  out.range = light.range;
+  out.position = {position.x, position.y, position.z};
+  out.direction = {direction.x, direction.y, direction.z};
+  out.node = node_index;
+  return out;
+}
+
+const tinygltf::Accessor& AccessorReader::accessor(int index, const std::string& where) const {
+  if (index < 0 || static_cast<size_t>(index) >= model_.accessors.size())
+    fail(fmt::format("{}: accessor {} does not exist ({} accessors)", where, index, model_.accessors.size()));
+  const tinygltf::Accessor& accessor = model_.accessors[static_cast<size_t>(index)];
+  if (accessor.sparse.isSparse) fail(fmt::format("{}: accessor {} is sparse, which is not supported", where, index));
+  return accessor;
+}
+
+AccessorSpan AccessorReader::span(const tinygltf::Accessor& accessor, int accessor_index, const std::string& where,
+                                  size_t element_size, size_t max_count, const char* limit_name) const {
+  if (accessor.bufferView < 0 || static_cast<size_t>(accessor.bufferView) >= model_.bufferViews.size())
+    fail(fmt::format("{}: accessor {} has no valid bufferView ({})", where, accessor_index, accessor.bufferView));
+  const tinygltf::BufferView& view = model_.bufferViews[static_cast<size_t>(accessor.bufferView)];
+  if (view.buffer < 0 || static_cast<size_t>(view.buffer) >= model_.buffers.size())
+    fail(fmt::format("{}: bufferView {} names buffer {}, which does not exist", where, accessor.bufferView, view.buffer));
+  const tinygltf::Buffer& buffer = model_.buffers[static_cast<size_t>(view.buffer)];
+  size_t view_end = 0;
+  if (__builtin_add_overflow(view.byteOffset, view.byteLength, &view_end) || view_end > buffer.data.size())
+    fail(fmt::format("{}: bufferView {} (byteOffset {}, byteLength {}) runs past the end of buffer {} ({} bytes)", where,
+                     accessor.bufferView, view.byteOffset, view.byteLength, view.buffer, buffer.data.size()));
+  // glTF: byteStride is 4..252 and a multiple of 4 (tinygltf checks it too); 0 means packed.
+  if (view.byteStride != 0 && (view.byteStride < 4 || view.byteStride > 252 || view.byteStride % 4 != 0))
+    fail(fmt::format("{}: bufferView {} has byteStride {} (must be 4 to 252, a multiple of 4)", where,
+                     accessor.bufferView, view.byteStride));
+  const int stride = accessor.ByteStride(view);
+  if (stride <= 0 || static_cast<size_t>(stride) < element_size)
+    fail(fmt::format("{}: accessor {} has an invalid byte stride {} for {}-byte elements (bufferView {})", where,
+                     accessor_index, stride, element_size, accessor.bufferView));
+  if (accessor.count > 0) {
+    size_t last_start = 0, end = 0;
+    if (__builtin_mul_overflow(static_cast<size_t>(stride), accessor.count - 1, &last_start) ||
+        __builtin_add_overflow(last_start, accessor.byteOffset, &last_start) ||
+        __builtin_add_overflow(last_start, element_size, &end) || end > view.byteLength)
+      fail(fmt::format("{}: accessor {} ({} elements of {} bytes, stride {}, from byteOffset {}) does not fit in "
+                       "bufferView {} ({} bytes)",
+                       where, accessor_index, accessor.count, element_size, stride, accessor.byteOffset,
+                       accessor.bufferView, view.byteLength));
+  }
+  if (accessor.count > max_count)
+    fail(fmt::format("{}: accessor {} has {} elements, over the limit of {} {}", where, accessor_index, accessor.count,
+                     max_count, limit_name));
+  return {buffer.data.data() + view.byteOffset + accessor.byteOffset, static_cast<size_t>(stride), accessor.count};
+}
+
+size_t AccessorReader::component_bytes(int component_type) {
+  switch (component_type) {
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
+    case TINYGLTF_COMPONENT_TYPE_BYTE:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
+    case TINYGLTF_COMPONENT_TYPE_SHORT:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
+    default: return 0;
+  }
+}
+
+// One component at `at` as glTF reads it: a float as stored, a normalised integer mapped to
+// [-1, 1] (signed, the most negative value clamped to -1) or [0, 1].
+static float normalised_component(const unsigned char* at, int component_type) {
+  switch (component_type) {
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: {
+      float value;
+      std::memcpy(&value, at, 4);
+      return value;
+    }
+    case TINYGLTF_COMPONENT_TYPE_BYTE: return std::max(float(static_cast<int8_t>(at[0])) / 127.0f, -1.0f);
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return float(at[0]) / 255.0f;
+    case TINYGLTF_COMPONENT_TYPE_SHORT: {
+      int16_t value;
+      std::memcpy(&value, at, 2);
+      return std::max(float(value) / 32767.0f, -1.0f);
+    }
+    default: {  // UNSIGNED_SHORT (component_bytes said which are read)
+      uint16_t value;
+      std::memcpy(&value, at, 2);
+      return float(value) / 65535.0f;
+    }
+  }
+}
+
+std::vector<float> AccessorReader::read_floats(const AccessorSpan& span, const tinygltf::Accessor& accessor, int index,
+                                               const std::string& where, size_t components) const {
+  const size_t bytes = component_bytes(accessor.componentType);
+  if (bytes == 0) fail(fmt::format("{}: accessor {} has component type {}, not one read here", where, index, accessor.componentType));
+  std::vector<float> values(span.count * components);
+  for (size_t i = 0; i < span.count; ++i) {
+    for (size_t c = 0; c < components; ++c)
+      values[i * components + c] = normalised_component(span.data + i * span.stride + c * bytes, accessor.componentType);
+    for (size_t c = 0; c < components; ++c)
+      if (!std::isfinite(values[i * components + c]))
+        fail(fmt::format("{}: accessor {} element {} is not finite ({})", where, index, i,
+                         fmt::join(values.begin() + std::ptrdiff_t(i * components),
+                                   values.begin() + std::ptrdiff_t((i + 1) * components), ", ")));
+  }
+  return values;
+}
+
+}  // namespace gltf
+
+namespace {
+
+// What load_gltf_mesh takes of the file, for the message when that holds no triangles.
+std::string selection_label(const tinygltf::Model& model, const GltfMeshSelection& selection, int node) {
+  std::string taken = node >= 0 ? fmt::format("the subtree of {}", gltf::node_label(model, node)) : "the scene";
+  if (selection.skip_animated) taken += " without the nodes its animations move";
+  return taken;
 }
 
 }  // namespace
 
-Mesh load_gltf_mesh(const std::filesystem::path& path) {
-  return as_asset_errors(path, [&] {
-    const tinygltf::Model model = load_checked_gltf_model(path);
+Mesh load_gltf_mesh(const std::filesystem::path& path) { return load_gltf_mesh(path, GltfMeshSelection{}); }
+
+Mesh load_gltf_mesh(const std::filesystem::path& path, const GltfMeshSelection& selection) {
+  return gltf::as_asset_errors(path, [&] {
+    const tinygltf::Model model = gltf::load_checked_model(path);
+    std::vector<int> roots = gltf::scene_roots(model);
+    int frame_node = -1;
+    if (!selection.node.empty()) {
+      // The whole scene's tree is checked first, as without a selection.
+      const std::optional<int> node = gltf::find_named_node(model, gltf::scene_node_tree(model, path), path, selection.node);
+      if (!node) gltf::fail(path, fmt::format("no node of the scene is named \"{}\"", selection.node));
+      frame_node = *node;
+      roots = {*node};
+    } else if (selection.skip_animated) {
+      gltf::scene_node_tree(model, path);  // the nodes left out are checked too
+    }
+    std::vector<bool> animated;
+    if (selection.skip_animated) animated = gltf::animated_nodes(model);
     GltfMeshCollector collector(model, path);
-    collector.add_roots(root_nodes(model));
-    return collector.finish();
+    collector.add_roots(roots, selection.skip_animated ? &animated : nullptr, frame_node);
+    return collector.finish(selection_label(model, selection, frame_node));
   });
 }
 
 std::vector<GltfLight> load_gltf_lights(const std::filesystem::path& path) {
-  return as_asset_errors(path, [&] {
-    const tinygltf::Model model = load_checked_gltf_model(path);
+  return gltf::as_asset_errors(path, [&] {
+    const tinygltf::Model model = gltf::load_checked_model(path);
     GltfMeshCollector collector(model, path, false);
-    collector.add_roots(root_nodes(model));
+    collector.add_roots(gltf::scene_roots(model));
     return collector.take_lights();
   });
 }

@@ -21,7 +21,10 @@ namespace arpipe {
 // offset and size is checked with overflow-checked arithmetic before a byte is read or a vector
 // made, the node graph is walked iteratively and must be a strict tree (no node with two parents)
 // within kMaxGltfNodeDepth, the output within kMaxGltfTriangles and kMaxGltfVertices; positions,
-// normals and node transforms must be finite. Mesh::source is set to `path`.
+// normals and node transforms must be finite. A node's rotation is normalised (glTF asks for unit
+// quaternions; one of zero length stays the identity). Mesh::source is set to `path`.
+// load_gltf_mesh(path, GltfMeshSelection) (gltf_animation.h) takes one node's subtree or the scene
+// without its animated nodes; this one is the whole scene, GltfMeshSelection{}.
 // Throws AssetError (and nothing else) naming the file and what was wrong: missing or unreadable
 // file, JSON or GLB syntax, a limit (stated in the message), a bad accessor (naming the mesh,
 // primitive, attribute and accessor), a bad node (naming it), no triangles at all.

@@ -23,8 +23,10 @@
 #include "core/geometry/camera_model.h"
 #include "core/image/openexr_file.h"
 #include "core/image/radiance_hdr.h"
+#include "core/scene/glb_writer.h"
 #include "render/prt/prt_cache.h"
 #include "tests/fuzz/fuzz_boards.h"
+#include "tests/scene/gltf_hostile_files.h"
 #include "tests/scene/gltf_test_files.h"
 
 namespace fs = std::filesystem;
@@ -62,6 +64,44 @@ std::string glb(std::string json, std::vector<uint8_t> bin) {
   return out;
 }
 
+// Animated scenes: an arm (LINEAR translation and rotation) holding a hand with a point light, a
+// STEP scale and a CUBICSPLINE translation on a post; and the writer's animated nodes as a .glb.
+void animated_gltf_seeds() {
+  render_test::AnimatedGltf file;
+  file.gltf["nodes"] = {{{"name", "arm"}, {"mesh", 0}, {"children", {1}}},
+                        {{"name", "hand"}, {"mesh", 0}, {"translation", {1, 0, 0}},
+                         {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}},
+                        {{"name", "post"}, {"mesh", 0}, {"scale", {1, 1, 1}}}};
+  file.gltf["scenes"] = {{{"nodes", {0, 2}}}};
+  file.gltf["extensions"] = {{"KHR_lights_punctual", {{"lights", {{{"type", "point"}, {"intensity", 3}}}}}}};
+  const int times = file.floats({0, 0.5f, 2}, "SCALAR");
+  const int moves = file.floats({0, 0, 0, 0, 1, 0, 1, 1, 0}, "VEC3");
+  const int turns = file.floats({0, 0, 0, 1, 0, 0.3826834f, 0, 0.9238795f, 0, 0.7071068f, 0, 0.7071068f}, "VEC4");
+  const int scales = file.floats({1, 1, 1, 2, 2, 2, 0.5f, 0.5f, 0.5f}, "VEC3");
+  const int cubic = file.floats({0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 1, 0, 0, 0, 0, 0, 0, 0, 2, 0, 0, 0, 0, 0}, "VEC3");
+  file.gltf["animations"] = {
+      {{"name", "move"},
+       {"samplers", {{{"input", times}, {"output", moves}},
+                     {{"input", times}, {"output", turns}, {"interpolation", "LINEAR"}},
+                     {{"input", times}, {"output", scales}, {"interpolation", "STEP"}},
+                     {{"input", times}, {"output", cubic}, {"interpolation", "CUBICSPLINE"}}}},
+       {"channels", {{{"sampler", 0}, {"target", {{"node", 0}, {"path", "translation"}}}},
+                     {{"sampler", 1}, {"target", {{"node", 0}, {"path", "rotation"}}}},
+                     {{"sampler", 2}, {"target", {{"node", 2}, {"path", "scale"}}}},
+                     {{"sampler", 3}, {"target", {{"node", 2}, {"path", "translation"}}}}}}}};
+  write("fuzz_gltf", "animated.gltf", file.done().dump());
+
+  Mesh triangle;
+  triangle.positions = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  triangle.indices = {0, 1, 2};
+  triangle.normals = {0, 0, 1, 0, 0, 1, 0, 0, 1};
+  GlbAnimatedNode arm{"arm", triangle, {{0, SE3()}, {1, SE3::from_rt({0, 0, 3}, {1, 0, 0})}, {2, SE3::from_rt({1, 0, 0}, {1, 1, 0})}}};
+  GltfLight lamp;
+  lamp.type = "point";
+  const std::vector<uint8_t> animated = encode_glb(triangle, "fuzz_make_seeds", {lamp}, {arm});
+  write("fuzz_gltf", "animated.glb", std::string(animated.begin(), animated.end()));
+}
+
 void gltf_seeds() {
   write("fuzz_gltf", "triangle.gltf", render_test::triangle_gltf());
   render_test::TriangleOptions flat;
@@ -90,6 +130,7 @@ void gltf_seeds() {
 {"buffer":0,"byteOffset":72,"byteLength":6}],
 "buffers":[{"byteLength":78}]})";
   write("fuzz_gltf", "two-nodes.glb", glb(json, bin));
+  animated_gltf_seeds();
 }
 
 HdrImage pattern(int width, int height) {

@@ -72,6 +72,60 @@ inline std::string triangle_glb(uint32_t bin_length_extra = 0) {
   return glb(gltf.dump(), triangle_buffer_bytes(), bin_length_extra);
 }
 
+// The triangle file grown into an animated scene: buffer 0 is the triangle's, buffer 1 (a data
+// URI made by done()) holds the keys and values each accessor call appends, each with a bufferView
+// of its own. Nodes, meshes, scenes and "animations" are the caller's to write into `gltf`.
+struct AnimatedGltf {
+  nlohmann::json gltf = triangle_json();
+  std::vector<uint8_t> data;
+
+  // An accessor of `values` as `type` ("SCALAR", "VEC3", "VEC4") of FLOAT; its index.
+  int floats(const std::vector<float>& values, const std::string& type) {
+    const size_t components = type == "SCALAR" ? 1 : type == "VEC3" ? 3 : 4;
+    return accessor(values, 5126, type, values.size() / components, false);
+  }
+  // An accessor of `values` as VEC4 of normalised SHORT (a rotation as glTF allows it); its index.
+  int normalized_shorts(const std::vector<int16_t>& values) { return accessor(values, 5122, "VEC4", values.size() / 4, true); }
+
+  // A mesh of the triangle with a material of its own of colour (r, g, b): its mesh index.
+  int coloured_mesh(float r, float g, float b) {
+    nlohmann::json mesh = gltf["meshes"][0];
+    mesh["primitives"][0]["material"] = gltf["materials"].size();
+    gltf["materials"].push_back({{"pbrMetallicRoughness", {{"baseColorFactor", {r, g, b, 1.0f}}}}});
+    gltf["meshes"].push_back(mesh);
+    return int(gltf["meshes"].size()) - 1;
+  }
+
+  nlohmann::json done() const {
+    nlohmann::json out = gltf;
+    if (!data.empty()) out["buffers"][1] = {{"byteLength", data.size()}, {"uri", data_uri(data)}};
+    return out;
+  }
+
+ private:
+  template <typename T>
+  int accessor(const std::vector<T>& values, int component_type, const std::string& type, size_t count, bool normalized) {
+    while (data.size() % 4 != 0) data.push_back(0);
+    const size_t offset = data.size();
+    append<T>(data, values);
+    gltf["bufferViews"].push_back({{"buffer", 1}, {"byteOffset", offset}, {"byteLength", values.size() * sizeof(T)}});
+    nlohmann::json accessor = {{"bufferView", gltf["bufferViews"].size() - 1},
+                               {"componentType", component_type},
+                               {"count", count},
+                               {"type", type}};
+    if (normalized) accessor["normalized"] = true;
+    gltf["accessors"].push_back(accessor);
+    return int(gltf["accessors"].size()) - 1;
+  }
+};
+
+// One sampler and one channel: `node`'s `path` keyed by the two accessors.
+inline nlohmann::json one_channel_animation(int node, const std::string& path, int input, int output,
+                                            const std::string& interpolation = "LINEAR") {
+  return {{"channels", {{{"sampler", 0}, {"target", {{"node", node}, {"path", path}}}}}},
+          {"samplers", {{{"input", input}, {"output", output}, {"interpolation", interpolation}}}}};
+}
+
 inline void write_file(const std::filesystem::path& path, const std::string& bytes) {
   std::ofstream(path, std::ios::binary | std::ios::trunc).write(bytes.data(), std::streamsize(bytes.size()));
 }
