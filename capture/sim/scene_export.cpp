@@ -3,11 +3,11 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "capture/sim/sim_object_mesh.h"
 #include "core/scene/builtin_meshes.h"
-#include "core/scene/glb_writer.h"
 
 namespace arpipe::sim {
 namespace {
@@ -30,6 +30,28 @@ Mesh object_frame_mesh(const SimObject& object) {
   throw std::invalid_argument(fmt::format("object \"{}\": an unknown shape", object.name));
 }
 
+MeshPart albedo_part(const SimObject& object, size_t first_index, size_t index_count) {
+  MeshPart part;
+  part.first_index = uint32_t(first_index);
+  part.index_count = uint32_t(index_count);
+  const Rgb& albedo = object.material.albedo;
+  part.base_color = {float(albedo[0]), float(albedo[1]), float(albedo[2]), 1.0f};
+  return part;
+}
+
+// A moving object as the hybrid viewer's animated proxy: its mesh in its own frame, one part of
+// its albedo, placed over time by its keys.
+GlbAnimatedNode animated_node(const SimObject& object) {
+  GlbAnimatedNode node;
+  node.name = object.name;
+  node.mesh = object_frame_mesh(object);
+  node.mesh.parts = {albedo_part(object, 0, node.mesh.indices.size())};
+  for (const SimPoseKey& key : object.keyframes) node.keys.push_back({key.time_s, key.T_world_object});
+  return node;
+}
+
+bool exported_as_animated(const SimObject& object) { return !object.is_virtual && !object.keyframes.empty(); }
+
 }  // namespace
 
 Mesh real_world_mesh(const SimScene& scene) { return real_world_mesh(scene, [](const Mesh& mesh) { return mesh; }); }
@@ -50,13 +72,8 @@ Mesh real_world_mesh(const SimScene& scene, const std::function<Mesh(const Mesh&
                          : Vec3{0, 0, 1};
       world.normals.insert(world.normals.end(), {float(n[0]), float(n[1]), float(n[2])});
     }
-    MeshPart part;
-    part.first_index = uint32_t(world.indices.size());
-    part.index_count = uint32_t(mesh.indices.size());
-    const Rgb& albedo = object.material.albedo;
-    part.base_color = {float(albedo[0]), float(albedo[1]), float(albedo[2]), 1.0f};
+    world.parts.push_back(albedo_part(object, world.indices.size(), mesh.indices.size()));
     for (uint32_t index : mesh.indices) world.indices.push_back(first_vertex + index);
-    world.parts.push_back(part);
   }
   if (world.indices.empty()) throw std::invalid_argument("the scene has no real object to export");
   return world;
@@ -82,8 +99,23 @@ std::vector<GltfLight> scene_lights(const SimScene& scene) {
   return out;
 }
 
+std::vector<GlbAnimatedNode> animated_nodes(const SimScene& scene) {
+  std::vector<GlbAnimatedNode> nodes;
+  for (const SimObject& object : scene.objects)
+    if (exported_as_animated(object)) nodes.push_back(animated_node(object));
+  return nodes;
+}
+
 std::vector<uint8_t> export_scene_glb(const SimScene& scene) {
-  return encode_glb(real_world_mesh(scene), "arpipe simulate --export-glb", scene_lights(scene));
+  constexpr std::string_view kGenerator = "arpipe simulate --export-glb";
+  const std::vector<GlbAnimatedNode> animated = animated_nodes(scene);
+  if (animated.empty()) return encode_glb(real_world_mesh(scene), kGenerator, scene_lights(scene));
+  SimScene still = scene;  // the real objects that stand still, or none: an empty static mesh
+  std::erase_if(still.objects, exported_as_animated);
+  const bool any_still = std::any_of(still.objects.begin(), still.objects.end(),
+                                     [](const SimObject& object) { return !object.is_virtual; });
+  return encode_glb(any_still ? real_world_mesh(still) : Mesh{}, kGenerator, scene_lights(scene), animated,
+                    kSceneAnimationName);
 }
 
 }  // namespace arpipe::sim
