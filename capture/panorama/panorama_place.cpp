@@ -63,10 +63,10 @@ PanoramaPlace::PanoramaPlace(PanoramaPlace&&) noexcept = default;
 void PanoramaPlace::arrive() {
   if (!is_video_) return;
   video_ = std::make_unique<PanoramaVideo>(viewpoint_.file, layout_, hardware_decoding_);
-  video_frame_ns_ = std::max<int64_t>(1, (1'000'000'000 * video_->rate_den() + video_->rate_num() / 2) / video_->rate_num());
   rate_num_ = video_->rate_num();
   rate_den_ = video_->rate_den();
   loop_offset_ns_ = 0;
+  passes_ = 0;
   if (!video_->next(shown_)) throw AssetError(fmt::format("panorama video \"{}\": no frame decodes", viewpoint_.file.string()));
   has_upcoming_ = video_->next(upcoming_);
   show(shown_);
@@ -94,16 +94,19 @@ EquirectImage& PanoramaPlace::show_at(int64_t t_ns, Eye eye) {
   const auto fetch = [&] { has_upcoming_ = video_->next(upcoming_); };
   bool changed = false;
   for (;;) {
-    while (has_upcoming_ && upcoming_.time_ns <= t_ns - loop_offset_ns_) {
+    while (has_upcoming_ && upcoming_.time_ns <= t_ns - loop_offset_ns_ + kShowSlackNs) {
       std::swap(shown_, upcoming_);
       changed = true;
       fetch();
     }
     if (has_upcoming_) break;
-    // The stream ended: the last frame lasts one frame time, then the video starts again.
-    const int64_t period = shown_.time_ns + video_frame_ns_;
-    if (t_ns - loop_offset_ns_ < period) break;
-    loop_offset_ns_ += period;
+    // The stream ended: the last frame lasts one frame time, then the video starts again. A pass is
+    // its frames at the nominal rate, each pass's start exact however many there were (no drift).
+    pass_frames_ = shown_.index + 1;
+    const int64_t next_pass_ns = pass_start_ns(passes_ + 1);
+    if (t_ns + kShowSlackNs < next_pass_ns) break;
+    ++passes_;
+    loop_offset_ns_ = next_pass_ns;
     video_->seek(0);
     fetch();
     if (!has_upcoming_) throw std::runtime_error("no frame after seeking to the start");
@@ -117,13 +120,20 @@ std::optional<int64_t> PanoramaPlace::frame_index() const {
   return shown_.index;
 }
 
-int64_t PanoramaPlace::frame_time_ns() const {
-  if (!is_video_) return 0;
-  // index * den / num seconds, exact in 128 bits (a long loop's index times 1e9 times den would
-  // overflow 64), then rounded.
+namespace {
+// frames * den / num seconds in nanoseconds, exact in 128 bits (frames times 1e9 times den can
+// overflow 64), then rounded.
+int64_t frames_to_ns(int64_t frames, int64_t rate_num, int64_t rate_den) {
   __extension__ typedef __int128 Int128;
-  const Int128 numerator = Int128(shown_.index) * rate_den_ * 1'000'000'000;
-  return int64_t((numerator + rate_num_ / 2) / rate_num_);
+  const Int128 numerator = Int128(frames) * rate_den * 1'000'000'000;
+  return int64_t((numerator + rate_num / 2) / rate_num);
+}
+}  // namespace
+
+int64_t PanoramaPlace::frame_time_ns() const { return is_video_ ? frames_to_ns(shown_.index, rate_num_, rate_den_) : 0; }
+
+int64_t PanoramaPlace::pass_start_ns(int64_t passes) const {
+  return frames_to_ns(passes * pass_frames_, rate_num_, rate_den_);
 }
 
 std::string PanoramaPlace::describe() const {

@@ -64,8 +64,15 @@ class PanoramaPlace {
   std::string video_description_;
   PanoramaVideoFrame shown_, upcoming_;
   bool has_upcoming_ = false;
-  int64_t loop_offset_ns_ = 0;  // the durations of the passes done
-  int64_t video_frame_ns_ = 0;  // one frame at the video's nominal rate
+  // Where pass `passes` of the video starts after arriving (0: the first).
+  int64_t pass_start_ns(int64_t passes) const;
+  // A video frame shows from its presentation time, both it and the output's time rounded to the
+  // nanosecond: a frame due within this much after the output's time is already due (else an output
+  // at the video's own rate would show the frame before, as the seed's viewer did by one frame).
+  static constexpr int64_t kShowSlackNs = 1000;
+  int64_t loop_offset_ns_ = 0;  // the start of the pass under way
+  int64_t passes_ = 0;          // passes done since arriving
+  int64_t pass_frames_ = 0;     // frames in one pass (known once the stream has ended)
   int64_t rate_num_ = 1, rate_den_ = 1;  // the nominal rate, frames per second as a fraction
   uint64_t skipped_before_ = 0;  // by the decoders of earlier visits
   std::unique_ptr<PanoramaLight> light_;     // a video's, for each frame shown

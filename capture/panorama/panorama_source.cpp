@@ -122,7 +122,11 @@ SourceStatus PanoramaSource::next(Frame& frame) {
   const uint64_t index = s.next_index, step = index / eyes;
   const Eye eye = eyes == 1 ? Eye::Mono : index % 2 == 0 ? Eye::Left : Eye::Right;
   int64_t start_ns = 0;
-  if (__builtin_mul_overflow(int64_t(step), s.interval_ns, &start_ns)) return SourceStatus::EndOfStream;
+  // Output frame k is at k / fps exactly, rounded to the nanosecond (k times a rounded interval
+  // would fall behind a video at the same rate by a third of a nanosecond a frame at 30 frames/s).
+  const long double exact_ns = (long double)step * 1e9L / panorama.view.fps;
+  if (!(exact_ns < 9e18L)) return SourceStatus::EndOfStream;
+  start_ns = std::llround(exact_ns);
   try {
     if (s.config.pacing == ReplayPacing::Timestamps && !s.clock.wait(start_ns)) return SourceStatus::Retry;
     const double t_s = double(step) / panorama.view.fps;

@@ -299,7 +299,7 @@ TEST(PanoramaVideo, AStereoVideoGivesEachTimeStepItsLeftThenItsRightEye) {
       ASSERT_EQ(source.next(frame), SourceStatus::Frame) << k;
       EXPECT_EQ(frame.meta.sequence, uint64_t(k));
       EXPECT_EQ(frame.meta.eye, k % 2 == 0 ? Eye::Left : Eye::Right) << k;
-      EXPECT_EQ(frame.meta.exposure_start_ns, (k / 2) * std::llround(1e9 / 30)) << k;
+      EXPECT_EQ(frame.meta.exposure_start_ns, std::llround((k / 2) * 1e9 / 30)) << k;  // k / fps exactly, rounded
       const uint8_t* centre = frame.data.data() + 4 * frame.bytes_per_line + 3 * 8;
       if (k % 2 == 0) EXPECT_TRUE(centre[0] > 200 && centre[2] < 60) << stack << " frame " << k << ": not red";
       else EXPECT_TRUE(centre[2] > 200 && centre[0] < 60) << stack << " frame " << k << ": not blue";
