@@ -91,9 +91,10 @@ void RenderStage::configure_loaded(const Config& config, const std::shared_ptr<c
   session_->make_current();
   if (!drawer_) drawer_ = std::make_unique<MotionBlurDrawer>(session_->context(), session_->layer().color_format());
   drawer_->prepare(config.render.blur.method);
-  std::vector<UploadedObject> objects = upload_objects(config, loaded->meshes);
-  // A stereo layout's proxies are cut for its eyes now; an "auto" one's on its first eye's frame.
+  // A stereo layout's objects and proxies are cut for its eyes now; an "auto" one's on its first
+  // eye's frame.
   const bool stereo = config.source.type == SourceType::Panorama && is_stereo(config.source.panorama.layout);
+  std::vector<UploadedObject> objects = upload_objects(config, loaded->meshes, stereo);
   std::vector<UploadedObject> proxies = upload_proxies(config, loaded->meshes, stereo);
   auto physics = std::make_unique<ScenePhysics>(config, loaded->meshes);
   if (physics->empty()) physics.reset();
@@ -147,7 +148,7 @@ void RenderStage::configure_loaded(const Config& config, const std::shared_ptr<c
   objects_ = std::move(objects);
   proxies_ = std::move(proxies);
   animator_ = std::make_unique<ProxyAnimator>(config, loaded->meshes, proxies_);
-  proxies_cut_for_stereo_ = stereo;
+  cut_for_stereo_ = stereo;
   assets_ = assets;
   proxy_config_ = config;
   physics_ = std::move(physics);
@@ -182,16 +183,24 @@ std::shared_ptr<const CameraModel> RenderStage::pinhole_core(const std::shared_p
 }
 
 void RenderStage::prepare_for_stereo() {
-  // The first eye's frame of an "auto" layout that turned out stereo: the proxies cut for the
-  // eyes' offsets, the ground catcher's square split.
-  if (!proxies_cut_for_stereo_ && !proxies_.empty()) {
+  // The first eye's frame of an "auto" layout that turned out stereo: the objects and proxies cut
+  // for the eyes' offsets, the ground catcher's square split.
+  if (!cut_for_stereo_ && !objects_.empty()) {
+    const auto* loaded = dynamic_cast<const RenderAssets*>(assets_.get());
+    if (!loaded) throw std::logic_error("RenderStage: no assets to cut the objects from");
+    // Only the meshes change: the objects keep their places (and the physics its bodies).
+    const std::vector<UploadedObject> cut = upload_objects(proxy_config_, loaded->meshes, true);
+    for (size_t i = 0; i < objects_.size() && i < cut.size(); ++i) objects_[i].mesh = cut[i].mesh;
+    reuse_.forget();
+  }
+  if (!cut_for_stereo_ && !proxies_.empty()) {
     const auto* loaded = dynamic_cast<const RenderAssets*>(assets_.get());
     if (!loaded) throw std::logic_error("RenderStage: no assets to cut the proxies from");
     proxies_ = upload_proxies(proxy_config_, loaded->meshes, true);
     animator_ = std::make_unique<ProxyAnimator>(proxy_config_, loaded->meshes, proxies_);
     reuse_.forget();
   }
-  proxies_cut_for_stereo_ = true;
+  cut_for_stereo_ = true;
   if (receiver_ && receiver_->subdivisions() < kBentReceiverSubdivisions)
     receiver_ = std::make_unique<ShadowReceiver>(kBentReceiverSubdivisions);
 }

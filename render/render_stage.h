@@ -77,7 +77,7 @@ class RenderStage final : public Stage {
   };
   enum class Drawn { Yes, Reused, OutOfView };
   Drawn draw(FrameContext& ctx);
-  // Cuts the proxies and splits the catcher for a stereo panorama's eyes, once.
+  // Cuts the objects and proxies and splits the catcher for a stereo panorama's eyes, once.
   void prepare_for_stereo();
   Lighting frame_lighting(const FrameContext& ctx, double& angular_diameter_rad) const;
   // The shadow map for this frame's light, or nullptr (ctx gets a "shadow" timing saying why).
@@ -110,9 +110,9 @@ class RenderStage final : public Stage {
   std::vector<UploadedObject> objects_;
   std::vector<UploadedObject> proxies_;  // [[render.proxies]], in config order
   std::unique_ptr<ProxyAnimator> animator_;  // places the animated ones among proxies_ per frame
-  // Whether proxies_ are cut for a stereo panorama's eyes (uploaded_objects.h); the meshes and the
+  // Whether objects_ and proxies_ are cut for a stereo panorama's eyes (uploaded_objects.h); the meshes and the
   // config they came from, to cut them when an "auto" layout's first eye's frame comes.
-  bool proxies_cut_for_stereo_ = false;
+  bool cut_for_stereo_ = false;
   std::shared_ptr<const StageAssets> assets_;
   Config proxy_config_;
   std::unique_ptr<ScenePhysics> physics_;  // nullptr when no object has a physics kind

@@ -258,13 +258,30 @@ std::vector<UploadedObject> upload_proxies(const Config& config, const LoadedMes
   return out;
 }
 
-std::vector<UploadedObject> upload_objects(const Config& config, const LoadedMeshes& loaded) {
+std::vector<UploadedObject> upload_objects(const Config& config, const LoadedMeshes& loaded, bool cut_for_stereo) {
   if (loaded.mesh_of_object.size() != config.render.objects.size())
     throw std::logic_error(fmt::format("upload_objects: {} objects loaded for a config with {}",
                                        loaded.mesh_of_object.size(), config.render.objects.size()));
+  // Cut for a stereo panorama's eyes as the proxies are (kOdsMaxEdgeM at the largest scale an
+  // object gives the mesh), the PRT transfer carried to the new vertices: the same shading.
+  std::vector<double> largest_scale(loaded.meshes.size(), 0);
+  for (size_t i = 0; i < config.render.objects.size(); ++i)
+    largest_scale[loaded.mesh_of_object[i]] = std::max(largest_scale[loaded.mesh_of_object[i]], config.render.objects[i].scale);
   std::vector<std::shared_ptr<const GpuMesh>> uploaded;
-  for (const LoadedMeshes::Entry& entry : loaded.meshes)
-    uploaded.push_back(std::make_shared<const GpuMesh>(entry.mesh, entry.transfer));
+  for (size_t m = 0; m < loaded.meshes.size(); ++m) {
+    const LoadedMeshes::Entry& entry = loaded.meshes[m];
+    if (!cut_for_stereo || largest_scale[m] <= 0) {
+      uploaded.push_back(std::make_shared<const GpuMesh>(entry.mesh, entry.transfer));
+      continue;
+    }
+    std::vector<float> transfer = entry.transfer;
+    const Mesh cut = transfer.empty() ? subdivided(entry.mesh, kOdsMaxEdgeM / largest_scale[m], kMaxStereoProxyTriangles)
+                                      : subdivided(entry.mesh, transfer, 9, kOdsMaxEdgeM / largest_scale[m], kMaxStereoProxyTriangles);
+    if (cut.triangle_count() != entry.mesh.triangle_count())
+      log::info("{}: cut from {} to {} triangles for the stereo eyes", entry.mesh.source, entry.mesh.triangle_count(),
+                cut.triangle_count());
+    uploaded.push_back(std::make_shared<const GpuMesh>(cut, transfer));
+  }
   std::vector<UploadedObject> objects;
   for (size_t i = 0; i < config.render.objects.size(); ++i) {
     const SceneObject& object = config.render.objects[i];

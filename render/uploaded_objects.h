@@ -99,7 +99,9 @@ LoadedMeshes load_object_meshes(const Config& config);
 
 // Uploads what load_object_meshes made of this same config and places the objects; needs a current
 // GL context.
-std::vector<UploadedObject> upload_objects(const Config& config, const LoadedMeshes& loaded);
+// cut_for_stereo: each mesh cut into triangles of at most kOdsMaxEdgeM (at its largest scale), the
+// PRT transfer carried along (for a stereo panorama's eyes, as the proxies).
+std::vector<UploadedObject> upload_objects(const Config& config, const LoadedMeshes& loaded, bool cut_for_stereo = false);
 // The same for render.proxies (UploadedObject::proxy), in config order.
 // cut_for_stereo: each cut into triangles of at most kOdsMaxEdgeM, without its coarser occluder
 // levels (for a stereo panorama's eyes).

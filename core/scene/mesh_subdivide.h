@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <vector>
 
 #include "core/scene/mesh.h"
 
@@ -14,5 +15,11 @@ namespace arpipe {
 // Normals are interpolated and renormalised. When that would make more than max_triangles, the
 // edge allowed grows until it does not; `used_edge_m`, when given, receives the edge used.
 Mesh subdivided(const Mesh& mesh, double max_edge_m, size_t max_triangles = 1'000'000, double* used_edge_m = nullptr);
+
+// The same, carrying values_per_vertex floats a vertex along (a PRT transfer): each new vertex gets
+// the mean of its edge's ends, the value the rasteriser interpolates there, so the cut mesh shades
+// exactly as the whole one. vertex_values holds mesh's vertices' values and receives the cut's.
+Mesh subdivided(const Mesh& mesh, std::vector<float>& vertex_values, size_t values_per_vertex, double max_edge_m,
+                size_t max_triangles = 1'000'000, double* used_edge_m = nullptr);
 
 }  // namespace arpipe

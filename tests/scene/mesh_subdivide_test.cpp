@@ -5,6 +5,10 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
+#include <stdexcept>
+#include <vector>
+
 #include "core/scene/builtin_meshes.h"
 #include "core/scene/mesh_weld.h"
 
@@ -66,6 +70,32 @@ TEST(MeshSubdivide, TheTriangleCapLengthensTheEdge) {
   EXPECT_GT(used, 0.1);
   EXPECT_LE(cut.triangle_count(), 10'000u * 2);
   EXPECT_LE(longest_edge(cut), used + 1e-3);
+}
+
+TEST(MeshSubdivide, CarriedValuesAreWhatTheRasteriserInterpolatesThere) {
+  // Two values a vertex, linear in the position (2x + 3y - z, and x): the mean of an edge's ends
+  // at its midpoint is that function there, so every new vertex holds the function's value (the
+  // shading a PRT transfer gives stays as it was). The geometry is the same cut as without values.
+  const Mesh box = make_box_mesh({0.5, 0.3, 0.2}, 1);
+  std::vector<float> values;
+  const auto f = [](const float* p) { return std::array<float, 2>{2 * p[0] + 3 * p[1] - p[2], p[0]}; };
+  for (size_t v = 0; v < box.vertex_count(); ++v) {
+    const auto value = f(&box.positions[3 * v]);
+    values.insert(values.end(), value.begin(), value.end());
+  }
+  const Mesh cut = subdivided(box, values, 2, 0.05);
+  const Mesh plain = subdivided(box, 0.05);
+  EXPECT_EQ(cut.positions, plain.positions);
+  EXPECT_EQ(cut.indices, plain.indices);
+  ASSERT_EQ(values.size(), 2 * cut.vertex_count());
+  ASSERT_GT(cut.vertex_count(), box.vertex_count());
+  for (size_t v = 0; v < cut.vertex_count(); ++v) {
+    const auto expected = f(&cut.positions[3 * v]);
+    EXPECT_NEAR(values[2 * v], expected[0], 1e-5) << "vertex " << v;
+    EXPECT_NEAR(values[2 * v + 1], expected[1], 1e-6) << "vertex " << v;
+  }
+  std::vector<float> wrong(3);
+  EXPECT_THROW(subdivided(box, wrong, 2, 0.05), std::invalid_argument);
 }
 
 }  // namespace
