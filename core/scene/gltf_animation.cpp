@@ -46,8 +46,9 @@ using gltf_animation_keys::PropertyTrack;
 // of its Gram matrix over the squared scale, against the identity's.
 constexpr double kUniformScaleTolerance = 1e-6;
 
-// glTF's y-up axes to the z-up object frame as a matrix (columns: where glTF's x, y, z go).
-const glm::dmat3 kGltfToObject(glm::dvec3(1, 0, 0), glm::dvec3(0, 0, 1), glm::dvec3(0, -1, 0));
+// glTF's y-up axes to the z-up object frame (C) as a matrix: its columns, where glTF's x, y, z go.
+const glm::dmat3 kGltfToObject(gltf::to_object_frame({1, 0, 0}), gltf::to_object_frame({0, 1, 0}),
+                               gltf::to_object_frame({0, 0, 1}));
 
 KeyInterpolation interpolation_named(const std::string& name) {
   if (name == "STEP") return KeyInterpolation::Step;
@@ -73,7 +74,8 @@ glm::dquat slerp_short_way(const glm::dquat& from, glm::dquat to, double s) {
     to = -to;
     cosine = -cosine;
   }
-  if (cosine > 1 - 1e-12) return glm::normalize(from + (to - from) * s);  // equal to ~1e-6 rad: no angle to divide by
+  // Within ~3e-6 rad of each other there is no angle to divide by; nlerp is exact to ~1e-17 there.
+  if (cosine > 1 - 1e-12) return glm::normalize(from + (to - from) * s);
   const double angle = std::acos(cosine);
   return (from * std::sin((1 - s) * angle) + to * std::sin(s * angle)) / std::sin(angle);
 }
@@ -92,7 +94,7 @@ glm::dvec4 sample_track(const PropertyTrack& track, double t, const std::filesys
   const bool rotation = track.property == AnimatedProperty::Rotation;
   auto key_value = [&](size_t k) {
     glm::dvec4 v = vector_at(track, stride * k + offset);
-    return rotation ? v / glm::length(v) : v;  // load_channel_track refused zero lengths
+    return rotation ? v / glm::length(v) : v;  // read_track refused zero lengths
   };
   if (!(t > double(times.front()))) return key_value(0);  // before the first key (and at it)
   if (t >= double(times.back())) return key_value(times.size() - 1);

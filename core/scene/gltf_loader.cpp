@@ -135,9 +135,8 @@ class GltfMeshCollector {
                      [&](int node_index, const glm::dmat4& parent) -> std::optional<glm::dmat4> {
                        if (skip != nullptr && (*skip)[static_cast<size_t>(node_index)]) return std::nullopt;
                        const tinygltf::Node& node = model_.nodes[static_cast<size_t>(node_index)];
-                       const glm::dmat4 transform =
-                           node_index == frame_node ? glm::dmat4(1.0)
-                                                    : parent * gltf::rest_transform(model_, path_, node_index);
+                       const glm::dmat4 local = gltf::rest_transform(model_, path_, node_index);  // checked even when left out
+                       const glm::dmat4 transform = node_index == frame_node ? glm::dmat4(1.0) : parent * local;
                        if (!all_finite(transform))
                          fail(fmt::format("node {}: its transform combined with its parents' is not finite (overflow)",
                                           node_index));
