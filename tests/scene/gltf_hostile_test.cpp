@@ -536,6 +536,32 @@ TEST_F(GltfHostile, AnimationRotationsThatAreNotRotationsAreRefused) {
   EXPECT_TRUE(contains(message, "accessor 5 must be VEC4 of FLOAT, or of normalized")) << message;
 }
 
+TEST_F(GltfHostile, AnimationSamplerOrChannelThatIsNotAnObjectIsRefused) {
+  json gltf = moving_triangle().done();
+  gltf["animations"][0]["samplers"][0] = "s";
+  EXPECT_TRUE(contains(load_error(write_gltf("sampler.gltf", gltf)), "animation 0 sampler 0: not an object"));
+  gltf = moving_triangle().done();
+  gltf["animations"][0]["channels"].push_back(json::array());
+  EXPECT_TRUE(contains(load_error(write_gltf("channel.gltf", gltf)), "animation 0 channel 1: not an object"));
+}
+
+// A CUBICSPLINE rotation between q and -q with flat tangents passes through zero at halfway: no
+// rotation there, an error naming the channel and the time.
+TEST_F(GltfHostile, AnimationCubicRotationThroughZeroIsRefusedWhereItIsZero) {
+  render_test::AnimatedGltf file;
+  const std::vector<float> flat{0, 0, 0, 0};
+  std::vector<float> keys = flat;
+  for (const std::vector<float>& part : {std::vector<float>{0, 0, 0, 1}, flat, flat, std::vector<float>{0, 0, 0, -1}, flat})
+    keys.insert(keys.end(), part.begin(), part.end());
+  const int times = file.floats({0, 2}, "SCALAR"), turns = file.floats(keys, "VEC4");
+  file.gltf["animations"] = {render_test::one_channel_animation(0, "rotation", times, turns, "CUBICSPLINE")};
+  const fs::path path = write_gltf("zero.gltf", file.done());
+  const GltfAnimation animation = GltfAnimation::load(path);
+  animation.node_pose_at(0, 0.5);  // a quarter of the way: still a rotation
+  const std::string message = error_of(path, [&] { animation.node_pose_at(0, 1); });
+  EXPECT_TRUE(contains(message, "animation 0 channel 0 (sampler 0): the rotation at t = 1 s has length 0")) << message;
+}
+
 TEST_F(GltfHostile, AnimationKeysPastTheLimitAreRefused) {
   // A GLB whose BIN chunk holds kMaxGltfAnimationKeys + 1 increasing times.
   std::vector<float> times(kMaxGltfAnimationKeys + 1);
