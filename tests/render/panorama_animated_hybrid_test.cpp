@@ -213,7 +213,7 @@ std::vector<bench::EdgeError> run_hybrid(bool animated, std::vector<double>* pos
   return out;
 }
 
-TEST(PanoramaAnimatedHybrid, AMovingProxyKeepsTheOcclusionEdgesOnTheRayTracedCoverageAt1080p) {
+TEST(PanoramaAnimatedHybrid, AMovingProxyKeepsTheOcclusionEdgesOnTheRayTracedCoverageAt1080pAndAStillOneDoesNot) {
   std::vector<double> post_x;
   const std::vector<bench::EdgeError> edges = run_hybrid(true, &post_x);
   ASSERT_EQ(edges.size(), kFrames.size());
@@ -227,17 +227,15 @@ TEST(PanoramaAnimatedHybrid, AMovingProxyKeepsTheOcclusionEdgesOnTheRayTracedCov
     EXPECT_GT(edges[i].edge_length_px, 400) << "frame " << kFrames[i];
     EXPECT_LE(edges[i].displacement_px, 1.0) << "frame " << kFrames[i];  // issue 23's bar
   }
-}
-
-TEST(PanoramaAnimatedHybrid, TheSameProxyLeftAtItsFirstKeyMissesTheEdgesWhileThePostCrosses) {
-  // What the test above would see if the proxy did not follow the video: the frames where the post
-  // hides part of the cube are off by far more than the bar (the check has teeth).
-  const std::vector<bench::EdgeError> edges = run_hybrid(false);
-  ASSERT_EQ(edges.size(), kFrames.size());
+  // The same proxy left at the post's first key (not following the video): the frames where the
+  // post hides part of the cube are off by far more than the bar (the check has teeth). One test
+  // with the one above: each test process simulates the captures again.
+  const std::vector<bench::EdgeError> at_rest = run_hybrid(false);
+  ASSERT_EQ(at_rest.size(), kFrames.size());
   double worst = 0;
   for (size_t i = 0; i < kFrames.size(); ++i) {
-    std::printf("frame %d, proxy at rest: mean displacement %.3f px\n", kFrames[i], edges[i].displacement_px);
-    worst = std::max(worst, edges[i].displacement_px);
+    std::printf("frame %d, proxy at rest: mean displacement %.3f px\n", kFrames[i], at_rest[i].displacement_px);
+    worst = std::max(worst, at_rest[i].displacement_px);
   }
   EXPECT_GT(worst, 3.0);
 }
