@@ -23,6 +23,7 @@
 #include "core/config/config.h"
 #include "core/track/tag_tracker.h"
 #include "render/gl_stages.h"
+#include "tests/render/proxies_world_text.h"
 
 namespace arpipe {
 namespace {
@@ -30,7 +31,6 @@ namespace {
 namespace fs = std::filesystem;
 constexpr double kPi = std::numbers::pi;
 constexpr double kDeg = kPi / 180;
-const fs::path kWorld = fs::path(ARPIPE_SOURCE_DIR) / "configs/sim/proxies.toml";
 const fs::path kConfig = fs::path(ARPIPE_SOURCE_DIR) / "configs/proxies.toml";
 
 constexpr int kPanoramaWidth = 1024, kPanoramaHeight = 512;
@@ -51,14 +51,7 @@ fs::path work_dir() {
 
 // configs/sim/proxies.toml's objects, lights and sky (with or without the virtual cube), and the post.
 std::string world(bool with_virtual_cube) {
-  std::ifstream in(kWorld);
-  std::stringstream text;
-  text << in.rdbuf();
-  std::string objects = text.str().substr(text.str().find("[[object]]"));
-  if (!with_virtual_cube) {
-    const size_t cube = objects.find("[[object]]\nname = \"virtual-cube\"");
-    objects.erase(cube, objects.find("[[light]]") - cube);
-  }
+  const std::string objects = test::proxies_world(with_virtual_cube);
   const std::string post = R"(
 [[object]]
 name = "post"
@@ -84,11 +77,7 @@ rotation_deg = [0.0, 0.0, 90.0]
   return objects.substr(0, lights) + post + "\n" + objects.substr(lights);
 }
 
-std::string common_sections(int samples, int frames) {
-  return fmt::format("[camera.sensor]\nnoise = false\n[render]\nsamples_per_pixel = {}\nframes = {}\nseed = 1\n"
-                     "[trajectory]\nkind = \"keyframes\"\n",
-                     samples, frames);
-}
+std::string common_sections(int samples, int frames) { return test::proxies_world_sections(samples, frames); }
 
 Vec3 view_forward() {
   return {std::cos(kPitchDeg * kDeg) * std::sin(kYawDeg * kDeg), std::cos(kPitchDeg * kDeg) * std::cos(kYawDeg * kDeg),

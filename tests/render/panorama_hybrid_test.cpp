@@ -24,6 +24,7 @@
 #include "core/config/config.h"
 #include "core/track/tag_tracker.h"
 #include "render/gl_stages.h"
+#include "tests/render/proxies_world_text.h"
 
 namespace arpipe {
 namespace {
@@ -31,7 +32,6 @@ namespace {
 namespace fs = std::filesystem;
 constexpr double kPi = std::numbers::pi;
 constexpr double kDeg = kPi / 180;
-const fs::path kWorld = fs::path(ARPIPE_SOURCE_DIR) / "configs/sim/proxies.toml";
 const fs::path kConfig = fs::path(ARPIPE_SOURCE_DIR) / "configs/proxies.toml";
 
 constexpr int kPanoramaWidth = 4096, kPanoramaHeight = 2048;
@@ -55,32 +55,8 @@ fs::path work_dir() {
   return dir;
 }
 
-// The world of configs/sim/proxies.toml: its objects, lights and sky, without or with the virtual cube.
-std::string world(bool with_virtual_cube) {
-  std::ifstream in(kWorld);
-  std::stringstream text;
-  text << in.rdbuf();
-  std::string objects = text.str().substr(text.str().find("[[object]]"));
-  if (!with_virtual_cube) {
-    const size_t cube = objects.find("[[object]]\nname = \"virtual-cube\"");
-    objects.erase(cube, objects.find("[[light]]") - cube);
-  }
-  return objects;
-}
-
-std::string common_sections(int samples, int frames) {
-  return fmt::format(R"(
-[camera.sensor]
-noise = false
-[render]
-samples_per_pixel = {}
-frames = {}
-seed = 1
-[trajectory]
-kind = "keyframes"
-)",
-                     samples, frames);
-}
+std::string world(bool with_virtual_cube) { return test::proxies_world(with_virtual_cube); }
+std::string common_sections(int samples, int frames) { return test::proxies_world_sections(samples, frames); }
 
 Vec3 forward_of(const Look& look) {
   const double yaw = look.yaw_deg * kDeg, pitch = look.pitch_deg * kDeg;

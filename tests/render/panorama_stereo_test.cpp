@@ -157,18 +157,15 @@ Centroids centroids(const Frame& background, const std::vector<float>& alpha, do
   return out;
 }
 
-// Per eye (left, right), the two centroids of the ball's view through the source and the stages.
-std::array<Centroids, 2> seen_by_both_eyes(const Config& config, const Ball& ball) {
+// The first time step's two frames (left eye, then right) through the source and the real stages:
+// per eye, f(eye, background, ctx) once the layer is drawn.
+template <class F>
+void for_both_eyes(const Config& config, F f) {
   static std::vector<std::unique_ptr<Stage>> stages = make_gl_stages();
   PanoramaSource source(config.source);
   TagTracker tracker;
   tracker.configure(config);
   for (auto& stage : stages) stage->configure(config);
-  // The ball's radius in the view, and a window 1.6 times that about it (the balls near the
-  // zenith are 10 degrees apart, 256 px here).
-  const double focal_px = 0.5 * kViewWidth / std::tan(0.5 * kViewHfovDeg * kDeg);
-  const double window_px = 1.6 * focal_px * kBallRadiusM / ball.distance_m;
-  std::array<Centroids, 2> eyes;
   for (size_t eye = 0; eye < 2; ++eye) {
     FrameContext ctx;
     EXPECT_EQ(source.next(ctx.camera), SourceStatus::Frame);
@@ -178,8 +175,20 @@ std::array<Centroids, 2> seen_by_both_eyes(const Config& config, const Ball& bal
     tracker.process(ctx);
     for (auto& stage : stages) stage->process(ctx);
     EXPECT_TRUE(ctx.virtual_layer_drawn);
-    if (ctx.virtual_layer_drawn) eyes[eye] = centroids(background, bench::layer_alpha(ctx.virtual_layer), window_px);
+    if (ctx.virtual_layer_drawn) f(eye, background, ctx);
   }
+}
+
+// Per eye (left, right), the two centroids of the ball's view through the source and the stages.
+std::array<Centroids, 2> seen_by_both_eyes(const Config& config, const Ball& ball) {
+  // The ball's radius in the view, and a window 1.6 times that about it (the balls near the
+  // zenith are 10 degrees apart, 256 px here).
+  const double focal_px = 0.5 * kViewWidth / std::tan(0.5 * kViewHfovDeg * kDeg);
+  const double window_px = 1.6 * focal_px * kBallRadiusM / ball.distance_m;
+  std::array<Centroids, 2> eyes;
+  for_both_eyes(config, [&](size_t eye, const Frame& background, const FrameContext& ctx) {
+    eyes[eye] = centroids(background, bench::layer_alpha(ctx.virtual_layer), window_px);
+  });
   return eyes;
 }
 
@@ -253,22 +262,10 @@ EdgeOffsets edge_offsets(const Frame& background, const std::vector<float>& alph
 
 // Both eyes' edge offsets, for a config looking at the slab's far edge.
 std::array<EdgeOffsets, 2> slab_edge_in_both_eyes(const Config& config, bool alpha_falls) {
-  static std::vector<std::unique_ptr<Stage>> stages = make_gl_stages();
-  PanoramaSource source(config.source);
-  TagTracker tracker;
-  tracker.configure(config);
-  for (auto& stage : stages) stage->configure(config);
   std::array<EdgeOffsets, 2> out;
-  for (size_t eye = 0; eye < 2; ++eye) {
-    FrameContext ctx;
-    EXPECT_EQ(source.next(ctx.camera), SourceStatus::Frame);
-    const Frame background = ctx.camera;
-    ctx.camera_model = source.camera_model();
-    tracker.process(ctx);
-    for (auto& stage : stages) stage->process(ctx);
-    EXPECT_TRUE(ctx.virtual_layer_drawn);
-    if (ctx.virtual_layer_drawn) out[eye] = edge_offsets(background, bench::layer_alpha(ctx.virtual_layer), alpha_falls);
-  }
+  for_both_eyes(config, [&](size_t eye, const Frame& background, const FrameContext& ctx) {
+    out[eye] = edge_offsets(background, bench::layer_alpha(ctx.virtual_layer), alpha_falls);
+  });
   return out;
 }
 
