@@ -470,6 +470,13 @@ std::vector<Row> measure_viewpoint(const sim::SimScene& scene, const Config& bas
 
 int run_hybrid_benchmark(const Options& options) {
   const sim::SimScene scene = sim::load_sim_scene(options.scene);
+  // Its proxies and its full 3D scene are the objects at rest: a scene that moves would be measured
+  // against geometry that stands still (render.objects do not follow a glTF animation).
+  for (const sim::SimObject& object : scene.objects)
+    if (!object.keyframes.empty())
+      throw std::invalid_argument(fmt::format("{}: object \"{}\" moves ([[object.keyframe]]); the benchmark's proxies and "
+                                              "full 3D scene stand still, so it takes static scenes only",
+                                              options.scene, object.name));
   Config base = load_config(options.config);
   if (base.source.type != SourceType::Panorama)
     throw std::invalid_argument(fmt::format("{}: source.type must be \"panorama\"", options.config));

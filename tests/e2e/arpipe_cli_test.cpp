@@ -219,6 +219,12 @@ TEST_F(ArpipeCli, BenchHybridRunsTheSeedsProtocolAgainstTheTruth) {
                 nullptr, &err),
             1);
   EXPECT_NE(err.find("source.type"), std::string::npos) << err;
+  // A scene whose objects move is refused by the object's name (the benchmark's geometry stands still).
+  EXPECT_EQ(run({"bench", "hybrid", "--scene", (configs / "sim" / "hybrid-animated.toml").string(), "--config",
+                 (configs / "hybrid-animated.toml").string(), "--work", (dir_ / "moving").string()},
+                nullptr, &err),
+            1);
+  EXPECT_NE(err.find("\"cart\" moves"), std::string::npos) << err;
   // A viewpoint that is not three numbers is a usage error naming the option.
   EXPECT_EQ(run({"bench", "hybrid", "--viewpoint", "1,2"}, nullptr, &err), 2);
   EXPECT_NE(err.find("--viewpoint"), std::string::npos) << err;
