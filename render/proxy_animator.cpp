@@ -35,7 +35,7 @@ bool ProxyAnimator::place(std::vector<UploadedObject>& proxies, std::optional<in
   const int64_t t = t_ns.value_or(0);
   report.time_s = 1e-9 * double(t);
   report.proxies.clear();
-  const bool moved = !placed_ || last_t_ns_ != t;
+  const bool moved = placed_at_ns_ != t;
   for (const Animated& a : animated_) {
     UploadedObject& proxy = proxies.at(a.index);
     if (moved) {
@@ -51,8 +51,7 @@ bool ProxyAnimator::place(std::vector<UploadedObject>& proxies, std::optional<in
     report.proxies.push_back(
         {proxy.name, proxy.T_world_object.translation(), proxy.T_world_object.rotation_vector(), proxy.scale});
   }
-  placed_ = true;
-  last_t_ns_ = t;
+  placed_at_ns_ = t;
   return moved;
 }
 

@@ -42,8 +42,7 @@ class ProxyAnimator {
     std::vector<double> occluder_level_errors_m;  // unscaled
   };
   std::vector<Animated> animated_;
-  std::optional<int64_t> last_t_ns_;
-  bool placed_ = false;
+  std::optional<int64_t> placed_at_ns_;  // none until the first frame
 };
 
 }  // namespace arpipe

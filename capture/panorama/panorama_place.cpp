@@ -9,6 +9,7 @@
 #include "capture/panorama/stereo_eye_pixels.h"
 #include "core/environment/hdr_environment.h"
 #include "core/image/hdr_file.h"
+#include "core/pipeline/frame_times.h"
 #include "core/scene/asset_error.h"
 
 namespace arpipe {
@@ -119,16 +120,6 @@ std::optional<int64_t> PanoramaPlace::frame_index() const {
   if (!is_video_) return std::nullopt;
   return shown_.index;
 }
-
-namespace {
-// frames * den / num seconds in nanoseconds, exact in 128 bits (frames times 1e9 times den can
-// overflow 64), then rounded.
-int64_t frames_to_ns(int64_t frames, int64_t rate_num, int64_t rate_den) {
-  __extension__ typedef __int128 Int128;
-  const Int128 numerator = Int128(frames) * rate_den * 1'000'000'000;
-  return int64_t((numerator + rate_num / 2) / rate_num);
-}
-}  // namespace
 
 int64_t PanoramaPlace::frame_time_ns() const { return is_video_ ? frames_to_ns(shown_.index, rate_num_, rate_den_) : 0; }
 

@@ -14,6 +14,7 @@
 #include "capture/panorama/panorama_view.h"
 #include "core/environment/hdr_environment.h"
 #include "core/log.h"
+#include "core/pipeline/frame_times.h"
 #include "core/scene/asset_error.h"
 
 namespace arpipe {
@@ -123,10 +124,10 @@ SourceStatus PanoramaSource::next(Frame& frame) {
   const Eye eye = eyes == 1 ? Eye::Mono : index % 2 == 0 ? Eye::Left : Eye::Right;
   int64_t start_ns = 0;
   // Output frame k is at k / fps exactly, rounded to the nanosecond (k times a rounded interval
-  // would fall behind a video at the same rate by a third of a nanosecond a frame at 30 frames/s).
-  const long double exact_ns = (long double)step * 1e9L / panorama.view.fps;
-  if (!(exact_ns < 9e18L)) return SourceStatus::EndOfStream;
-  start_ns = std::llround(exact_ns);
+  // would fall behind a video at the same rate by a third of a nanosecond a frame at 30 frames/s);
+  // nothing past 285 years.
+  if (!(double(step) / panorama.view.fps < 9e9)) return SourceStatus::EndOfStream;
+  start_ns = frame_offset_ns(panorama.view.fps, step);
   try {
     if (s.config.pacing == ReplayPacing::Timestamps && !s.clock.wait(start_ns)) return SourceStatus::Retry;
     const double t_s = double(step) / panorama.view.fps;

@@ -37,28 +37,28 @@ struct EnvironmentAssets final : StageAssets {
 // lux times the scale; a point or spot light is a lamp at its place whose irradiance at the world
 // origin is its candela over the squared distance (the spot's cone is not modelled); strongest first.
 // A lamp at the world origin has no direction from there: left out (warned about when `warn`).
-std::vector<DirectionalLight> direct_lights(const std::vector<GltfLight>& file_lights, const Config& config, bool warn) {
-  const PanoramaLightConfig& c = config.light.panorama;
+std::vector<DirectionalLight> direct_lights(const std::vector<GltfLight>& file_lights, const SceneLightUnits& units,
+                                           bool warn) {
   std::vector<DirectionalLight> out;
   for (const GltfLight& light : file_lights) {
     DirectionalLight d;
     // Punctual lights have no size: the penumbra keeps the config's source size.
-    d.angular_diameter_rad = config.render.shadows.light_angular_diameter_deg * std::numbers::pi / 180;
+    d.angular_diameter_rad = units.angular_diameter_rad;
     if (light.type == "directional") {
       d.direction_world = -1.0 * light.direction;
-      d.irradiance = (c.lights_scale * light.intensity) * light.color;
+      d.irradiance = (units.lights_scale * light.intensity) * light.color;
     } else {
       const double distance = norm(light.position);
       if (!(distance > 1e-6)) {
         if (warn)
-          log::warn("{}: light \"{}\" (node {}) sits at the world origin: left out", c.lights_file.string(), light.name,
+          log::warn("{}: light \"{}\" (node {}) sits at the world origin: left out", units.file.string(), light.name,
                     light.node);
         continue;
       }
       d.local = true;
       d.position_world = light.position;
       d.direction_world = (1 / distance) * light.position;
-      d.irradiance = (c.lights_scale * light.intensity / (distance * distance)) * light.color;
+      d.irradiance = (units.lights_scale * light.intensity / (distance * distance)) * light.color;
     }
     out.push_back(d);
   }
@@ -66,6 +66,11 @@ std::vector<DirectionalLight> direct_lights(const std::vector<GltfLight>& file_l
     return std::max({a.irradiance[0], a.irradiance[1], a.irradiance[2]}) > std::max({b.irradiance[0], b.irradiance[1], b.irradiance[2]});
   });
   return out;
+}
+
+SceneLightUnits scene_light_units(const Config& config) {
+  return {config.light.panorama.lights_scale, config.render.shadows.light_angular_diameter_deg * std::numbers::pi / 180,
+          config.light.panorama.lights_file};
 }
 
 // The file's lights at the animation's start, and the animation when it moves one of them.
@@ -80,7 +85,7 @@ void load_scene_lights(const Config& config, EnvironmentAssets& assets) {
   } catch (const std::exception& e) {
     throw ConfigError(fmt::format("{}: light.panorama.lights_file: {}", config.file.string(), e.what()));
   }
-  assets.scene_lights = direct_lights(file_lights, config, true);
+  assets.scene_lights = direct_lights(file_lights, scene_light_units(config), true);
   if (assets.scene_lights.empty())
     throw ConfigError(fmt::format("{}: light.panorama.lights_file: {} has no KHR_lights_punctual light on its scene's nodes",
                                   config.file.string(), c.lights_file.string()));
@@ -93,7 +98,7 @@ void LightStage::pose_scene_lights(FrameContext& ctx) noexcept {
   const int64_t t_ns = ctx.camera.meta.source_frame_time_ns.value_or(0);
   if (panorama_.posed_at_ns == t_ns) return;
   try {
-    std::vector<DirectionalLight> lights = direct_lights(panorama_.animation->lights_at(1e-9 * double(t_ns)), panorama_.config, false);
+    std::vector<DirectionalLight> lights = direct_lights(panorama_.animation->lights_at(1e-9 * double(t_ns)), panorama_.units, false);
     if (lights.empty()) throw std::runtime_error("every light sits at the world origin");
     panorama_.direct = std::move(lights);
     panorama_.posed_at_ns = t_ns;
@@ -157,7 +162,7 @@ void LightStage::configure_loaded(const Config& config, const std::shared_ptr<co
     panorama_.window = light.panorama.window;
     panorama_.direct = loaded->scene_lights;
     panorama_.animation = loaded->lights_animation;
-    panorama_.config = config;
+    panorama_.units = scene_light_units(config);
     if (!light.panorama.lights_file.empty())
       log::info("light: {} direct light(s) from {}, the strongest casting shadows", panorama_.direct.size(),
                 light.panorama.lights_file.string());

@@ -5,6 +5,7 @@
 // FrameContext::light to the renderer.
 #pragma once
 
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
@@ -19,6 +20,14 @@
 #include "core/pipeline/stage.h"
 
 namespace arpipe {
+
+// What turns light.panorama.lights_file's photometric lights into the render's direct lights
+// (its lights_scale, the penumbra's source size) and names the file in messages.
+struct SceneLightUnits {
+  double lights_scale = 1;
+  double angular_diameter_rad = 0;
+  std::filesystem::path file;
+};
 
 class LightStage final : public Stage {
  public:
@@ -44,7 +53,7 @@ class LightStage final : public Stage {
     ShWindow window = ShWindow::None;
     // lights_file's animation, when it moves a light: the lights posed at each frame's time.
     std::shared_ptr<const GltfAnimation> animation;
-    Config config;  // lights_scale and the light's size, for posing them
+    SceneLightUnits units;
     std::optional<int64_t> posed_at_ns = int64_t{0};
   } panorama_;                   // Panorama: with the SH each frame brings
   void pose_scene_lights(FrameContext& ctx) noexcept;
