@@ -403,6 +403,22 @@ void draw_mesh(const ObjectAtInstant& item, const LensUniforms& lens, const Pixe
   object.mesh->draw_parts([&](size_t part) { return cluster_in_rect(object.cluster_bounds[part], item.poses, lens, cull_rect); });
 }
 
+// Draws the ground catcher in each of lighting.ground_catcher_rects (all of cull_rect when none),
+// leaving the scissor at cull_rect.
+void within_ground_rects(const Lighting& lighting, const PixelRect& cull_rect, const std::function<void()>& draw) {
+  if (lighting.ground_catcher_rects.empty()) {
+    draw();
+    return;
+  }
+  for (const PixelRect& rect : lighting.ground_catcher_rects) {
+    const PixelRect r = rect.intersected(cull_rect);
+    if (r.empty()) continue;
+    glScissor(r.x, r.y, r.width, r.height);
+    draw();
+  }
+  glScissor(cull_rect.x, cull_rect.y, cull_rect.width, cull_rect.height);
+}
+
 // The coarsest occluder level of the item's proxy that strays at most tolerance_px at the nearest
 // corner of its box over the item's row poses; null: the full mesh (no level fits, the box reaches
 // the near plane, or the lens is applied per vertex, which long edges would not follow).
@@ -555,7 +571,7 @@ void ObjectRenderer::draw_items(const LensUniforms& lens, const RowProjection& r
       set_object_placement(baked_catcher_, *item.object);
       glDepthMask(item.object->writes_depth ? GL_TRUE : GL_FALSE);  // as the per-pixel path
       cull_back_faces_of(*item.object);
-      item.object->mesh->draw([](const MeshPart&) {});
+      within_ground_rects(lighting, cull_rect, [&] { item.object->mesh->draw([](const MeshPart&) {}); });
       continue;
     }
     if (!shades(*item.object)) {
@@ -595,10 +611,14 @@ void ObjectRenderer::draw_items(const LensUniforms& lens, const RowProjection& r
     }
     const GLint base_color = in_use.base_color;
     cull_back_faces_of(object);
-    draw_mesh(item, lens, cull_rect, [&](const MeshPart& part) {
-      const std::array<float, 4>& color = item.object->base_color ? *item.object->base_color : part.base_color;
-      glUniform4f(base_color, color[0], color[1], color[2], color[3]);
-    });
+    const auto draw_it = [&] {
+      draw_mesh(item, lens, cull_rect, [&](const MeshPart& part) {
+        const std::array<float, 4>& color = item.object->base_color ? *item.object->base_color : part.base_color;
+        glUniform4f(base_color, color[0], color[1], color[2], color[3]);
+      });
+    };
+    if (object.shadow_catcher && !object.proxy) within_ground_rects(lighting, cull_rect, draw_it);
+    else draw_it();
   }
   glDepthMask(GL_TRUE);
   glDisable(GL_CULL_FACE);

@@ -59,6 +59,10 @@ struct Lighting {
   // The objects no shadow reaches this frame (render/shadow/unshadowed_objects.h): drawn without
   // the shadow lookups, which would all return 1 on them.
   std::vector<const UploadedObject*> unshadowed;
+  // Where the ground catcher can be other than transparent (canvas pixels, no two overlapping):
+  // it is drawn only there, within the pass's scissor, which must then be its cull rectangle on
+  // the whole canvas's viewport. Empty: everywhere.
+  std::vector<PixelRect> ground_catcher_rects;
 };
 
 struct ObjectAtInstant {

@@ -393,6 +393,7 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
   request.lighting = frame_lighting(ctx, angular_diameter_rad);
   bool shadow_redrawn = false;
   request.lighting.shadow = shadow_for(ctx, request.lighting, angular_diameter_rad, request.objects, shadow_redrawn);
+  std::vector<PixelRect> each_shadow_rects;  // per present object, where its shadow can fall; empty: unbounded
   if (request.lighting.shadow) {
     // Where the objects' shadows (and the sky they hide) can fall: the receivers join the
     // footprint only there. The ground catcher's patch spans every object's shadow, so with
@@ -401,13 +402,25 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
     const std::vector<SE3> seen_from{instants.front().T_cam_world, instants[instants.size() / 2].T_cam_world,
                                      instants.back().T_cam_world};
     PixelRect shadows;
+    each_shadow_rects.clear();
+    bool bounded = true;
     for (const SE3& T_cam_world : seen_from) {
       // (Not bounded through an eye's offsets: then the receivers whole.)
-      const std::optional<PixelRect> r =
-          eye == Eye::Mono ? shadow_volume_rect(image_camera, T_cam_world, request.lighting) : std::nullopt;
+      const std::optional<std::vector<PixelRect>> r =
+          eye == Eye::Mono ? shadow_volume_rects(image_camera, T_cam_world, request.lighting) : std::nullopt;
       // Unbounded (a grazing light): every receiver in view, whole.
-      shadows = shadows.united(r ? *r : PixelRect::full(camera.width(), camera.height()));
+      if (!r) {
+        shadows = PixelRect::full(camera.width(), camera.height());
+        bounded = false;
+        continue;
+      }
+      each_shadow_rects.resize(r->size());
+      for (size_t i = 0; i < r->size(); ++i) {
+        shadows = shadows.united((*r)[i]);
+        each_shadow_rects[i] = each_shadow_rects[i].united((*r)[i]);
+      }
     }
+    if (!bounded) each_shadow_rects.clear();
     rect = rect.united(proxy_receivers.intersected(shadows));
     // The sky occlusion darkens the ground catcher's whole patch (faded at its edge).
     const PixelRect ground_reach =
@@ -420,6 +433,17 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
   }
   if (settings_.full_canvas) rect = PixelRect::full(camera.width(), camera.height());
   request.rect = warp ? warp->canvas_rect_for(rect) : rect;
+  // Without sky occlusion the ground catcher darkens only where a shadow falls: it is drawn in
+  // each object's shadow rectangle alone, not over the whole footprint between them.
+  request.lighting.ground_catcher_rects.clear();
+  if (request.lighting.shadow && !settings_.shadows.sky_occlusion && !settings_.full_canvas && !each_shadow_rects.empty()) {
+    std::vector<PixelRect> on_canvas;
+    for (const PixelRect& r : each_shadow_rects)
+      if (!r.empty()) on_canvas.push_back((warp ? warp->canvas_rect_for(r) : r).intersected(request.rect));
+    request.lighting.ground_catcher_rects = disjoint_rects(std::move(on_canvas));
+    // None at all would mean "everywhere" to the renderer: an empty rectangle says nowhere.
+    if (request.lighting.ground_catcher_rects.empty()) request.lighting.ground_catcher_rects.push_back(PixelRect{});
+  }
   // The ground catcher under the multisampled objects when nothing else is drawn: a proxy that
   // hides must hide the catcher too, which needs the depth the objects' samples hold.
   request.catcher_under = request.lighting.shadow && occluders.empty() && receivers_first.empty();
@@ -661,8 +685,8 @@ bool RenderStage::move_objects(const ShutterMotion& motion) {
   return moved;
 }
 
-std::optional<PixelRect> RenderStage::shadow_volume_rect(const CameraModel& camera, const SE3& T_cam_world,
-                                                        const Lighting& lighting) const {
+std::optional<std::vector<PixelRect>> RenderStage::shadow_volume_rects(const CameraModel& camera, const SE3& T_cam_world,
+                                                                      const Lighting& lighting) const {
   // Each object's shadow lies in the hull of its box and the box's projection onto the ground
   // along the light (the sweep), and the shadow lookups near it read it from up to the filter's
   // reach away: the sweep grown by a square that holds that reach. With sky occlusion, the
@@ -670,12 +694,19 @@ std::optional<PixelRect> RenderStage::shadow_volume_rect(const CameraModel& came
   // for the lens's bend, and cut at the near plane, so that an object beside or behind the camera
   // bounds only the part of its shadow in front of it.
   constexpr int kSamples = 8;
-  const double h = settings_.shadows.receiver_height_m;
-  PixelRect rect;
+  // Down to the ground, or to the lowest shadow-catching proxy below it: a proxy's part under the
+  // real floor shows where the floor is no proxy (the ground catcher draws no depth before it),
+  // and catches the shadow further along the light.
+  double h = settings_.shadows.receiver_height_m;
+  for (const UploadedObject& proxy : proxies_)
+    if (proxy.shadow_catcher)
+      for (const Vec3& corner : box_corners(proxy.bounds)) h = std::min(h, (proxy.T_world_object * corner)[2]);
+  std::vector<PixelRect> rects;
   std::vector<Vec3> points;
   for (const UploadedObject& object : objects_) {
     if (!object.present) continue;
     points.clear();
+    PixelRect& rect = rects.emplace_back();
     const std::array<Vec3, 8> local = box_corners(object.bounds);
     // The penumbra, or the shadow filter's own reach when the map's texels are coarser (a map
     // fitted around large real casters).
@@ -725,10 +756,9 @@ std::optional<PixelRect> RenderStage::shadow_volume_rect(const CameraModel& came
     }
     // Object by object: the hull is convex, their union is not (one beside the camera on the left
     // and one on the right would span the picture). Behind the camera or out of the picture: none.
-    if (const std::optional<PixelRect> drawn = projected_points_rect(camera, points, kRectMarginPx))
-      rect = rect.united(*drawn);
+    if (const std::optional<PixelRect> drawn = projected_points_rect(camera, points, kRectMarginPx)) rect = *drawn;
   }
-  return rect;
+  return rects;
 }
 
 double RenderStage::moving_objects_motion_px(const ShutterMotion& motion, const CameraModel& camera) const {

@@ -87,10 +87,11 @@ class RenderStage final : public Stage {
   // Steps the physics to the frame's exposure end and places the moving objects at its middle;
   // whether any of them moved since the last frame.
   bool move_objects(const ShutterMotion& motion);
-  // Where the objects' shadows can fall in the image (their boxes' shadow volumes down to the
-  // ground); empty when none is in view; nullopt when it cannot be bounded (a grazing light).
-  std::optional<PixelRect> shadow_volume_rect(const CameraModel& camera, const SE3& T_cam_world,
-                                              const Lighting& lighting) const;
+  // Where each present object's shadow can fall in the image (its box's shadow volume down to the
+  // ground), in objects_'s order less the absent ones; an empty rectangle when out of view;
+  // nullopt when one cannot be bounded (a grazing light).
+  std::optional<std::vector<PixelRect>> shadow_volume_rects(const CameraModel& camera, const SE3& T_cam_world,
+                                                            const Lighting& lighting) const;
   // The largest image motion of a moving object's box corners over the exposure (its own blur).
   double moving_objects_motion_px(const ShutterMotion& motion, const CameraModel& camera) const;
   std::shared_ptr<const LensWarpMap> warp_map(const std::shared_ptr<const CameraModel>& camera_model);

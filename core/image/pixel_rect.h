@@ -4,6 +4,7 @@
 #pragma once
 
 #include <algorithm>
+#include <vector>
 
 namespace arpipe {
 
@@ -35,5 +36,22 @@ struct PixelRect {
   }
   bool operator==(const PixelRect&) const = default;
 };
+
+// The rectangles with every two that overlap replaced by the smallest one holding both, until no
+// two overlap (so that drawing into each covers no pixel twice); empty ones dropped.
+inline std::vector<PixelRect> disjoint_rects(std::vector<PixelRect> rects) {
+  std::erase_if(rects, [](const PixelRect& r) { return r.empty(); });
+  for (bool merged = true; merged;) {
+    merged = false;
+    for (size_t i = 0; i < rects.size() && !merged; ++i)
+      for (size_t j = i + 1; j < rects.size() && !merged; ++j)
+        if (!rects[i].intersected(rects[j]).empty()) {
+          rects[i] = rects[i].united(rects[j]);
+          rects.erase(rects.begin() + static_cast<long>(j));
+          merged = true;
+        }
+  }
+  return rects;
+}
 
 }  // namespace arpipe
