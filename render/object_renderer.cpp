@@ -403,14 +403,14 @@ void draw_mesh(const ObjectAtInstant& item, const LensUniforms& lens, const Pixe
   object.mesh->draw_parts([&](size_t part) { return cluster_in_rect(object.cluster_bounds[part], item.poses, lens, cull_rect); });
 }
 
-// Draws the ground catcher in each of lighting.ground_catcher_rects (all of cull_rect when none),
-// leaving the scissor at cull_rect.
+// Draws the ground catcher in each of lighting.ground_catcher_rects (all of cull_rect without
+// them), leaving the scissor at cull_rect.
 void within_ground_rects(const Lighting& lighting, const PixelRect& cull_rect, const std::function<void()>& draw) {
-  if (lighting.ground_catcher_rects.empty()) {
+  if (!lighting.ground_catcher_rects) {
     draw();
     return;
   }
-  for (const PixelRect& rect : lighting.ground_catcher_rects) {
+  for (const PixelRect& rect : *lighting.ground_catcher_rects) {
     const PixelRect r = rect.intersected(cull_rect);
     if (r.empty()) continue;
     glScissor(r.x, r.y, r.width, r.height);

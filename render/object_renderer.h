@@ -6,6 +6,7 @@
 #include <array>
 #include <compare>
 #include <map>
+#include <optional>
 #include <utility>
 #include <span>
 #include <vector>
@@ -61,8 +62,8 @@ struct Lighting {
   std::vector<const UploadedObject*> unshadowed;
   // Where the ground catcher can be other than transparent (canvas pixels, no two overlapping):
   // it is drawn only there, within the pass's scissor, which must then be its cull rectangle on
-  // the whole canvas's viewport. Empty: everywhere.
-  std::vector<PixelRect> ground_catcher_rects;
+  // the whole canvas's viewport. None: everywhere (an empty list: nowhere).
+  std::optional<std::vector<PixelRect>> ground_catcher_rects;
 };
 
 struct ObjectAtInstant {

@@ -402,8 +402,6 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
     const std::vector<SE3> seen_from{instants.front().T_cam_world, instants[instants.size() / 2].T_cam_world,
                                      instants.back().T_cam_world};
     PixelRect shadows;
-    each_shadow_rects.clear();
-    bool bounded = true;
     for (const SE3& T_cam_world : seen_from) {
       // (Not bounded through an eye's offsets: then the receivers whole.)
       const std::optional<std::vector<PixelRect>> r =
@@ -411,8 +409,8 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
       // Unbounded (a grazing light): every receiver in view, whole.
       if (!r) {
         shadows = PixelRect::full(camera.width(), camera.height());
-        bounded = false;
-        continue;
+        each_shadow_rects.clear();
+        break;
       }
       each_shadow_rects.resize(r->size());
       for (size_t i = 0; i < r->size(); ++i) {
@@ -420,7 +418,6 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
         each_shadow_rects[i] = each_shadow_rects[i].united((*r)[i]);
       }
     }
-    if (!bounded) each_shadow_rects.clear();
     rect = rect.united(proxy_receivers.intersected(shadows));
     // The sky occlusion darkens the ground catcher's whole patch (faded at its edge).
     const PixelRect ground_reach =
@@ -435,14 +432,12 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
   request.rect = warp ? warp->canvas_rect_for(rect) : rect;
   // Without sky occlusion the ground catcher darkens only where a shadow falls: it is drawn in
   // each object's shadow rectangle alone, not over the whole footprint between them.
-  request.lighting.ground_catcher_rects.clear();
+  request.lighting.ground_catcher_rects.reset();
   if (request.lighting.shadow && !settings_.shadows.sky_occlusion && !settings_.full_canvas && !each_shadow_rects.empty()) {
     std::vector<PixelRect> on_canvas;
     for (const PixelRect& r : each_shadow_rects)
       if (!r.empty()) on_canvas.push_back((warp ? warp->canvas_rect_for(r) : r).intersected(request.rect));
     request.lighting.ground_catcher_rects = disjoint_rects(std::move(on_canvas));
-    // None at all would mean "everywhere" to the renderer: an empty rectangle says nowhere.
-    if (request.lighting.ground_catcher_rects.empty()) request.lighting.ground_catcher_rects.push_back(PixelRect{});
   }
   // The ground catcher under the multisampled objects when nothing else is drawn: a proxy that
   // hides must hide the catcher too, which needs the depth the objects' samples hold.
