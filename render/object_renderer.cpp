@@ -133,7 +133,11 @@ void main() {{
   }}
   float lit = ambient * (1.0 - occlusion) + visibility * direct;
   float ratio = ambient + real_direct > 0.0 ? min(lit / (ambient + real_direct), 1.0) : 1.0;
+#if BAKE_TO_RED
+  out_color = vec4(1.0 - ratio);  // a one-channel bake (catcher_bake.h) keeps red
+#else
   out_color = vec4(0.0, 0.0, 0.0, 1.0 - ratio);
+#endif
 #else
 #if WITH_PRT
   vec3 environment = v_prt_radiance;
@@ -205,12 +209,12 @@ void main() {
 constexpr std::string_view kBakedCatcherFragmentShader = R"glsl(#version 300 es
 precision highp float;
 in vec2 v_ground;
-uniform highp sampler2D u_catcher_ratio;  // alpha: 1 - ratio, as the shading program draws it
+uniform highp sampler2D u_catcher_ratio;  // red: 1 - ratio, as the shading program bakes it
 uniform vec4 u_bake_square;
 out vec4 out_color;
 
 void main() {
-  out_color = vec4(0.0, 0.0, 0.0, texture(u_catcher_ratio, (v_ground - u_bake_square.xy) / (u_bake_square.zw - u_bake_square.xy)).a);
+  out_color = vec4(0.0, 0.0, 0.0, texture(u_catcher_ratio, (v_ground - u_bake_square.xy) / (u_bake_square.zw - u_bake_square.xy)).r);
 }
 )glsl";
 
@@ -323,8 +327,10 @@ std::string variant_defines(const ShadingVariant& variant) {
                      variant.prt, variant.specular);
 }
 
-std::string shading_fragment_source(const ShadingVariant& variant) {
-  return fmt::format(fmt::runtime(kShadingFragmentShaderTemplate), fmt::arg("defines", variant_defines(variant)),
+// bake: the ground catcher's bake, which keeps its alpha in a one-channel texture's red.
+std::string shading_fragment_source(const ShadingVariant& variant, bool bake) {
+  return fmt::format(fmt::runtime(kShadingFragmentShaderTemplate),
+                     fmt::arg("defines", fmt::format("{}\n#define BAKE_TO_RED {:d}", variant_defines(variant), bake)),
                      fmt::arg("shadow_lookup", shadow_lookup_glsl(variant.method)),
                      fmt::arg("real_shadow_lookup",
                               shadow_lookup_glsl(variant.real_shadow ? variant.method : ShadowMethod::Off, "real_")),
@@ -341,12 +347,12 @@ std::string shading_program_name(std::string_view what, const ShadingVariant& va
 // shader and the vertex shader `vertex` makes from the variant's defines.
 const GlProgram& program_for_variant(std::map<ShadingVariant, GlProgram>& programs, std::string_view what,
                                      const std::function<std::string(std::string_view)>& vertex,
-                                     const ShadingVariant& variant) {
+                                     const ShadingVariant& variant, bool bake = false) {
   auto found = programs.find(variant);
   if (found == programs.end())
     found = programs
                 .emplace(variant, GlProgram(shading_program_name(what, variant), vertex(variant_defines(variant)),
-                                            shading_fragment_source(variant)))
+                                            shading_fragment_source(variant, bake)))
                 .first;
   return found->second;
 }
@@ -363,7 +369,7 @@ const GlProgram& ObjectRenderer::baking(ShadowMethod method, bool real_shadow) {
   return program_for_variant(
       baking_, "ground catcher bake",
       [](std::string_view defines) { return fmt::format("#version 300 es\n{}\n{}", defines, kCatcherBakeVertexShader); },
-      ShadingVariant{method, real_shadow, true, false, false});
+      ShadingVariant{method, real_shadow, true, false, false}, true);
 }
 
 namespace {

@@ -119,7 +119,9 @@ Lighting::BakedCatcher CatcherBake::for_frame(ObjectRenderer& renderer, const Li
 
   const int size = std::clamp(static_cast<int>(std::bit_ceil(static_cast<unsigned>(std::ceil(texels_needed)))),
                               kMinCatcherBakeTexels, kMaxCatcherBakeTexels);
-  target_.ensure(GL_RGBA16F, size, size, false);
+  // One channel: the catcher draws alpha alone, and a quarter of the memory is a quarter of what
+  // each frame's lookups bring through the caches.
+  target_.ensure(GL_R16F, size, size, false);
   glBindTexture(GL_TEXTURE_2D, target_.texture());
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
