@@ -32,7 +32,7 @@ struct WorkArea {
 class WorkAreaChooser {
  public:
   static constexpr int kAlignment = 32;
-  static constexpr int kStep = 64;
+  static constexpr int kStep = 16;
   static constexpr int kShrinkAfter = 30;
 
   // An empty area (width 0) when rect lies outside the canvas.
