@@ -109,11 +109,8 @@ void VirtualLayer::ensure_objects_image(int width, int height) {
 
 void VirtualLayer::begin_objects(const WorkArea& area, const PixelRect& rect, const PixelRect& objects_rect) {
   if (samples_ <= 1) throw RenderError("the objects' own image needs multisampling");
-  const GLfloat transparent[4] = {0, 0, 0, 0};
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-  clear_written_outside(resolved_framebuffer_.get(), resolved_written_, rect);
-  begin_resolved(rect);
-  glClearBufferfv(GL_COLOR, 0, transparent);  // one sample a pixel: cheap, unlike the multisampled clear
+  layer_rect_ = rect;  // cleared after the copy (resolve_objects)
   ensure_objects_image(area.width, area.height);
   objects_area_ = area;
   objects_rect_ = objects_rect;
@@ -139,6 +136,12 @@ void VirtualLayer::resolve_objects() {
   glBindFramebuffer(GL_DRAW_FRAMEBUFFER, resolved_framebuffer_.get());
   glBlitFramebuffer(local.x, local.y, local.right(), local.bottom(), to.x, to.y, to.right(), to.bottom(),
                     GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  // The rest of the layer's rectangle, and what earlier frames left outside it, cleared after the
+  // copy rather than before: the clears then join what is drawn there next (the catcher) in one
+  // pass of a software rasteriser over its tiles, instead of a pass of their own.
+  clear_written_outside(resolved_framebuffer_.get(), resolved_written_, layer_rect_);
+  PixelRect around_objects = layer_rect_;
+  clear_written_outside(resolved_framebuffer_.get(), around_objects, to);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 

@@ -26,13 +26,13 @@ class VirtualLayer {
   // Makes what was drawn inside rect available in texture().
   void resolve(const PixelRect& rect);
 
-  // For objects drawn apart from what follows them (the ground catcher): clears texture() inside
-  // rect (and what earlier frames left outside it, as begin), then binds a multisampled image of
-  // `area` alone (work_area.h), cleared whole, to draw into with viewport = the canvas placed so
-  // that canvas pixel (area.x, area.y) lands on its texel (0, 0), scissor = objects_rect (canvas
-  // pixels, within area) seen there. Needs samples() > 1.
+  // For objects drawn apart from what follows them (the ground catcher): binds a multisampled
+  // image of `area` alone (work_area.h), cleared whole, to draw into with viewport = the canvas
+  // placed so that canvas pixel (area.x, area.y) lands on its texel (0, 0), scissor = objects_rect
+  // (canvas pixels, within area) seen there. Needs samples() > 1.
   void begin_objects(const WorkArea& area, const PixelRect& rect, const PixelRect& objects_rect);
-  // Resolves what was drawn since begin_objects and copies it to its place in texture().
+  // Resolves what was drawn since begin_objects, copies it to its place in texture(), and clears
+  // the rest of texture() inside rect (and what earlier frames left outside it, as begin).
   void resolve_objects();
   // Binds texture()'s framebuffer to draw into, viewport = whole image, scissor = rect.
   void begin_resolved(const PixelRect& rect);
@@ -67,6 +67,7 @@ class VirtualLayer {
   GlFramebuffer objects_resolved_framebuffer_;
   WorkArea objects_area_;
   PixelRect objects_rect_;
+  PixelRect layer_rect_;  // begin_objects's rect
   PixelRect resolved_written_;  // what texture() may hold: all of it after allocation  // the multisampled one, or resolved_framebuffer_'s twin with depth
 };
 
