@@ -445,6 +445,20 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
   if (request.catcher_under) {
     const PixelRect objects_only = settings_.full_canvas ? rect : objects_rect;
     request.objects_rect = (warp ? warp->canvas_rect_for(objects_only) : objects_only).intersected(request.rect);
+    // A point on or above the ground and a camera centre on or above it: the segment between them
+    // stays above it, so the ground hides nothing of that point. (An eye of a stereo panorama is
+    // left to the depth, and so is the full canvas, the path the footprint tests compare against.)
+    const double ground_z = request.objects.back()->T_world_object.translation()[2];
+    bool above = eye == Eye::Mono && !settings_.full_canvas;
+    for (const Instant& instant : instants) {
+      above = above && instant.T_cam_world.inverse().translation()[2] >= ground_z;
+      for (size_t i = 0; above && i + 1 < request.objects.size(); ++i) {
+        const UploadedObject& object = *request.objects[i];
+        const SE3 T_world_object = object.pose_at ? object.pose_at(instant.t_ns) : object.T_world_object;
+        above = world_box(object.bounds, T_world_object).min[2] >= ground_z;
+      }
+    }
+    request.ground_hides_nothing = above;
   }
   request.image_motion_px = motion.valid() ? std::max(motion.max_image_motion_px, moving_objects_motion_px(motion, image_camera)) : 0;
   request.msaa_samples = settings_.msaa_samples;

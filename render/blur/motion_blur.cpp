@@ -63,7 +63,7 @@ void MotionBlurDrawer::draw_at(VirtualLayer& layer, const LayerDrawRequest& requ
   layer.begin_objects(objects_area_, request.rect, request.objects_rect);
   pass_times::mark("clear");
   const std::span<const ObjectAtInstant> without_catcher(objects.data(), objects.size() - 1);
-  objects_.draw_ground_catcher_depth(request.lens, request.rows, objects.back());
+  if (!request.ground_hides_nothing) objects_.draw_ground_catcher_depth(request.lens, request.rows, objects.back());
   objects_.draw(request.lens, request.rows, request.lighting, without_catcher, request.objects_rect,
                 request.occluder_lod_px);
   pass_times::mark("objects");

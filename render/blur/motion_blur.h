@@ -39,6 +39,9 @@ struct LayerDrawRequest {
   // draw_ground_catcher_under); objects_rect (within rect) is what the others can reach.
   bool catcher_under = false;
   PixelRect objects_rect;
+  // With catcher_under: no object reaches below the ground and no camera centre lies below it, so
+  // the ground hides nothing and its depth (which hides what of an object is below it) is not drawn.
+  bool ground_hides_nothing = false;
   double image_motion_px = 0;              // ShutterMotion::max_image_motion_px
   int msaa_samples = 4;
   bool rolling_shutter = true;
