@@ -2,6 +2,7 @@
 // through the camera model, used to skip frames with nothing in view and to limit GL work.
 #include "render/projected_bounds.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <vector>
@@ -28,12 +29,52 @@ void append_segment_in_front(std::vector<Vec3>& points_cam, const Vec3& a, const
   for (int s = 0; s <= samples; ++s) points_cam.push_back(from + (double(s) / samples) * (to - from));
 }
 
+bool append_pinhole_outline(std::vector<Vec3>& points_cam, const std::vector<Vec3>& vertices, int samples) {
+  const double near = kNearPlaneM * (1 + 1e-9);
+  if (vertices.empty()) return true;
+  for (const Vec3& v : vertices)
+    if (!(v[2] > near)) return false;
+  // Andrew's monotone chain on the pinhole points, carrying each one's camera-frame vertex.
+  std::vector<size_t> order(vertices.size());
+  std::vector<Vec2> at(vertices.size());
+  for (size_t i = 0; i < vertices.size(); ++i) {
+    order[i] = i;
+    at[i] = Vec2{vertices[i][0] / vertices[i][2], vertices[i][1] / vertices[i][2]};
+  }
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return at[a] < at[b]; });
+  const auto turn = [&](size_t o, size_t a, size_t b) {
+    return (at[a][0] - at[o][0]) * (at[b][1] - at[o][1]) - (at[a][1] - at[o][1]) * (at[b][0] - at[o][0]);
+  };
+  std::vector<size_t> hull(2 * order.size());
+  size_t k = 0;
+  for (size_t i = 0; i < order.size(); ++i) {  // lower chain
+    while (k >= 2 && turn(hull[k - 2], hull[k - 1], order[i]) <= 0) --k;
+    hull[k++] = order[i];
+  }
+  for (size_t i = order.size() - 1, lower = k + 1; i-- > 0;) {  // upper chain
+    while (k >= lower && turn(hull[k - 2], hull[k - 1], order[i]) <= 0) --k;
+    hull[k++] = order[i];
+  }
+  hull.resize(k > 1 ? k - 1 : k);  // the last point repeats the first
+  if (hull.size() == 1) {
+    points_cam.push_back(vertices[hull[0]]);
+    return true;
+  }
+  for (size_t i = 0; i < hull.size(); ++i)
+    append_segment_in_front(points_cam, vertices[hull[i]], vertices[hull[(i + 1) % hull.size()]], samples);
+  return true;
+}
+
 std::optional<PixelRect> projected_box_rect(const CameraModel& camera, const SE3& T_cam_object, const Bounds& box,
                                             double margin_px) {
   std::array<Vec3, 8> corners = box_corners(box);
   for (Vec3& corner : corners) corner = T_cam_object * corner;
   std::vector<Vec3> points;
   points.reserve(12 * (kSamplesPerEdge + 1));
+  // In front of the near plane, the outline's edges alone (a convex box's outline is made of its
+  // edges); else every edge, cut there.
+  if (append_pinhole_outline(points, std::vector<Vec3>(corners.begin(), corners.end()), kSamplesPerEdge))
+    return projected_points_rect(camera, points, margin_px);
   for (int a = 0; a < 8; ++a)
     for (int bit = 1; bit < 8; bit <<= 1) {
       if (a & bit) continue;  // each edge once, from the corner with the bit clear

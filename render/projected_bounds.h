@@ -25,6 +25,15 @@ std::optional<PixelRect> projected_box_rect(const CameraModel& camera, const SE3
 // the projection of its visible part.
 void append_segment_in_front(std::vector<Vec3>& points_cam, const Vec3& a, const Vec3& b, int samples);
 
+// For the convex hull of `vertices` (camera frame), all in front of the near plane: appends
+// samples + 1 points along each edge of its outline as a pinhole sees it (the 2D convex hull of
+// the points (x / z, y / z)). A pinhole maps segments to segments, so that outline bounds the
+// hull's projection; a lens bends it, and the samples follow the bend as an edge's would. Far
+// fewer points than all the hull's edges: a box swept along the light and grown by a square has
+// 64 vertices and 192 edges, and its outline about ten. Returns false (appending nothing) when a
+// vertex lies at or behind the near plane.
+bool append_pinhole_outline(std::vector<Vec3>& points_cam, const std::vector<Vec3>& vertices, int samples);
+
 // The same for any set of camera-frame points (a shape's edges, sampled densely enough for the
 // lens's bend): their bounding rectangle, widened, clipped; the whole image when some lie behind
 // the near plane and others in front; nullopt when all lie behind or it misses the image.

@@ -703,6 +703,7 @@ std::optional<std::vector<PixelRect>> RenderStage::shadow_volume_rects(const Cam
   // for the lens's bend, and cut at the near plane, so that an object beside or behind the camera
   // bounds only the part of its shadow in front of it.
   constexpr int kSamples = 8;
+  constexpr int kOutlineSamples = 16;  // an outline edge spans several of the sum's edges
   // Down to the ground, or to the lowest shadow-catching proxy below it: a proxy's part under the
   // real floor shows where the floor is no proxy (the ground catcher draws no depth before it),
   // and catches the shadow further along the light.
@@ -739,8 +740,26 @@ std::optional<std::vector<PixelRect>> RenderStage::shadow_volume_rects(const Cam
       sweep[i] = corners[i];
       sweep[8 + i] = corners[i] - ((corners[i][2] - h) / towards[i][2]) * towards[i];
     }
-    // The sum of the sweep and the square: each of the sweep's edges moved to each of the square's
-    // corners, and the square's edges placed at each of the sweep's vertices.
+    // The sum of the sweep and the square lies in the convex hull of its 64 vertices (each sweep
+    // vertex moved to each of the square's corners), and so does the sky occlusion's square: when
+    // all lie in front of the near plane, the outline of that hull bounds it (a tenth of the
+    // points of the edges below, each projected through the lens).
+    std::vector<Vec3> vertices;
+    for (const Vec3& vertex : sweep)
+      for (const Vec3& shift : square) vertices.push_back(T_cam_world * (vertex + shift));
+    if (settings_.shadows.sky_occlusion) {
+      const Vec3 centre = object.T_world_object * (0.5 * (object.bounds.min + object.bounds.max));
+      const double half = 2 * object.sky_radius_m;
+      for (size_t i = 0; i < 4; ++i)
+        vertices.push_back(T_cam_world * Vec3{centre[0] + ((i == 1 || i == 2) ? half : -half),
+                                              centre[1] + (i >= 2 ? half : -half), h});
+    }
+    if (append_pinhole_outline(points, vertices, kOutlineSamples)) {
+      if (const std::optional<PixelRect> drawn = projected_points_rect(camera, points, kRectMarginPx)) rect = *drawn;
+      continue;
+    }
+    // Some reach behind the near plane: the sum's edges cut there, each of the sweep's edges moved
+    // to each of the square's corners, and the square's edges placed at each of the sweep's vertices.
     const auto edge = [&](const Vec3& a, const Vec3& b) {
       append_segment_in_front(points, T_cam_world * a, T_cam_world * b, kSamples);
     };

@@ -5,7 +5,10 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <cstdint>
+#include <vector>
 
 #include "render_test_support.h"
 
@@ -42,6 +45,54 @@ TEST(ProjectedBounds, RectangleHoldsEveryProjectedPointOfTheBox) {
   // And it is tight: no more than a pixel of slack on a side without margin (rounding out to whole pixels).
   EXPECT_LE(min_u - (rect->x - 0.5), 1.0);
   EXPECT_LE((rect->right() - 0.5) - max_u, 1.0);
+}
+
+// The outline of a convex hull as a pinhole sees it bounds, through a distorting lens, every point
+// of the hull (random convex combinations of its vertices), and it is as tight as the rectangle of
+// every segment between two vertices.
+TEST(ProjectedBounds, ThePinholeOutlineBoundsTheWholeHullThroughTheLens) {
+  const SE3 pose = look_at({0.1, -0.25, 0.2}, {-0.05, 0.0, 0.03});
+  uint64_t state = 12345;
+  const auto uniform = [&state] {  // a fixed sequence in [0, 1)
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return double(state >> 11) * 0x1.0p-53;
+  };
+  std::vector<Vec3> vertices;
+  for (int i = 0; i < 64; ++i)
+    vertices.push_back(pose * Vec3{0.12 * uniform() - 0.06, 0.12 * uniform() - 0.06, 0.08 * uniform()});
+  std::vector<Vec3> outline;
+  ASSERT_TRUE(append_pinhole_outline(outline, vertices, 16));
+  EXPECT_LT(outline.size(), size_t(17 * 20)) << "an outline, not every edge";
+  const auto rect = projected_points_rect(kCamera, outline, 0.0);
+  ASSERT_TRUE(rect.has_value());
+  for (int n = 0; n < 20000; ++n) {
+    // A random point of the hull: a convex combination of four random vertices.
+    std::array<double, 4> w{};
+    double total = 0;
+    for (double& x : w) total += (x = uniform());
+    Vec3 p{0, 0, 0};
+    for (double x : w) p = p + (x / total) * vertices[size_t(uniform() * 64) % 64];
+    const auto pixel = kCamera.project(p);
+    ASSERT_TRUE(pixel.has_value());
+    ASSERT_GE((*pixel)[0], rect->x - 0.5);
+    ASSERT_LT((*pixel)[0], rect->right() - 0.5);
+    ASSERT_GE((*pixel)[1], rect->y - 0.5);
+    ASSERT_LT((*pixel)[1], rect->bottom() - 0.5);
+  }
+  std::vector<Vec3> every_edge;
+  for (size_t a = 0; a < vertices.size(); ++a)
+    for (size_t b = a + 1; b < vertices.size(); ++b) append_segment_in_front(every_edge, vertices[a], vertices[b], 16);
+  const auto all = projected_points_rect(kCamera, every_edge, 0.0);
+  ASSERT_TRUE(all.has_value());
+  EXPECT_LE(std::abs(rect->x - all->x), 1);
+  EXPECT_LE(std::abs(rect->y - all->y), 1);
+  EXPECT_LE(std::abs(rect->right() - all->right()), 1);
+  EXPECT_LE(std::abs(rect->bottom() - all->bottom()), 1);
+  // A vertex at the near plane: no outline (the caller cuts the edges there instead).
+  std::vector<Vec3> none;
+  vertices.push_back(Vec3{0.0, 0.0, 0.0});
+  EXPECT_FALSE(append_pinhole_outline(none, vertices, 16));
+  EXPECT_TRUE(none.empty());
 }
 
 TEST(ProjectedBounds, MarginWidensAndTheImageClips) {
