@@ -62,12 +62,29 @@ void smooth(const uint8_t* image, size_t stride, int width, int height, std::vec
 
 }  // namespace
 
+SmoothedPatch smoothed_patch(const uint8_t* image, size_t stride, int width, int height) {
+  SmoothedPatch out;
+  if (!image || width < 8 || height < 8) return out;
+  std::vector<float> across;
+  smooth(image, stride, width, height, out.pixels, across);
+  out.width = width;
+  out.height = height;
+  return out;
+}
+
 std::optional<PatchMotion> patch_motion(const uint8_t* reference, size_t reference_stride, const uint8_t* current,
                                         size_t current_stride, int width, int height) {
   if (!reference || !current || width < 8 || height < 8) return std::nullopt;
+  return patch_motion(smoothed_patch(reference, reference_stride, width, height), current, current_stride);
+}
+
+std::optional<PatchMotion> patch_motion(const SmoothedPatch& reference, const uint8_t* current, size_t current_stride) {
+  const int width = reference.width, height = reference.height;
+  if (!current || width < 8 || height < 8 || reference.pixels.size() != size_t(width) * size_t(height))
+    return std::nullopt;
   // Scratch kept per thread: a tracker calls this every frame.
-  thread_local std::vector<float> ref, cur, across;
-  smooth(reference, reference_stride, width, height, ref, across);
+  thread_local std::vector<float> cur, across;
+  const std::vector<float>& ref = reference.pixels;
   smooth(current, current_stride, width, height, cur, across);
   const size_t stride = size_t(width);
   // Every other pixel each way: a quarter of the work, and still thousands of edge pixels on a tag.

@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <vector>
 
 namespace arpipe {
 
@@ -25,5 +26,16 @@ struct PatchMotion {
 // two frames. nullopt when the patch has too little texture to measure motion (or is under 8 px).
 std::optional<PatchMotion> patch_motion(const uint8_t* reference, size_t reference_stride, const uint8_t* current,
                                         size_t current_stride, int width, int height);
+
+// A reference patch smoothed once (the fit smooths both patches), for a reference that later frames
+// are measured against one after another: a still camera's tags.
+struct SmoothedPatch {
+  std::vector<float> pixels;  // width x height, smoothed
+  int width = 0;
+  int height = 0;
+};
+SmoothedPatch smoothed_patch(const uint8_t* image, size_t stride, int width, int height);
+// The same as patch_motion on the patch `reference` was made from, to the bit.
+std::optional<PatchMotion> patch_motion(const SmoothedPatch& reference, const uint8_t* current, size_t current_stride);
 
 }  // namespace arpipe

@@ -147,7 +147,7 @@ struct TagTracker::Impl {
   // The last detection's tags' patch and pose (track.still_px), while frames since are tracked.
   struct StillReference {
     PixelRect box;
-    std::vector<uint8_t> luma;  // box.width x box.height
+    SmoothedPatch luma;  // box.width x box.height, smoothed once for patch_motion
     PoseEstimate pose;
     std::optional<std::array<double, 4>> bundle_box;  // x0, y0, x1, y1 of the bundle projected with pose
   };
@@ -334,7 +334,7 @@ bool TagTracker::Impl::keep_still_pose(FrameContext& ctx, const std::optional<SE
   if (needs_luma) pixels = luma(frame, box);
   const uint8_t* current = pixels + size_t(box.y) * stride + size_t(box.x);
   const std::optional<PatchMotion> motion =
-      patch_motion(still->luma.data(), size_t(box.width), current, stride, box.width, box.height);
+      patch_motion(still->luma, current, stride);
   // More than this share of pixels the motion cannot explain: something crossed the tags. More
   // than this change of contrast: not the same picture (a flat one fits with a gain of -1), or an
   // exposure step worth detecting again.
@@ -366,12 +366,11 @@ void TagTracker::Impl::remember_still(const FrameContext& ctx, const uint8_t* pi
   // A few pixels beyond the corners: the border's outer edges are in it, whichever way it moves.
   const PixelRect rect = grown_rect(box, 4.0, 1, frame.width, frame.height);
   if (rect.width < 16 || rect.height < 16) return;
-  StillReference reference{rect, std::vector<uint8_t>(size_t(rect.width) * size_t(rect.height)), ctx.pose, {}};
+  StillReference reference{rect, smoothed_patch(pixels + size_t(rect.y) * stride + size_t(rect.x), stride, rect.width,
+                                                 rect.height),
+                            ctx.pose, {}};
   if (const auto kept = project_bundle(*ctx.camera_model, ctx.pose.T_cam_world, world_corners_by_id))
     reference.bundle_box = std::array<double, 4>{kept->x0, kept->y0, kept->x1, kept->y1};
-  for (int y = 0; y < rect.height; ++y)
-    std::copy_n(pixels + size_t(rect.y + y) * stride + size_t(rect.x), size_t(rect.width),
-                reference.luma.data() + size_t(y) * size_t(rect.width));
   still = std::move(reference);
 }
 
