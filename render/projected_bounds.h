@@ -31,7 +31,7 @@ void append_segment_in_front(std::vector<Vec3>& points_cam, const Vec3& a, const
 // hull's projection; a lens bends it, and the samples follow the bend as an edge's would. Far
 // fewer points than all the hull's edges: a box swept along the light and grown by a square has
 // 64 vertices and 192 edges, and its outline about ten. Returns false (appending nothing) when a
-// vertex lies at or behind the near plane.
+// vertex lies at or behind the near plane or is not finite.
 bool append_pinhole_outline(std::vector<Vec3>& points_cam, const std::vector<Vec3>& vertices, int samples);
 
 // The same for any set of camera-frame points (a shape's edges, sampled densely enough for the

@@ -93,6 +93,10 @@ TEST(ProjectedBounds, ThePinholeOutlineBoundsTheWholeHullThroughTheLens) {
   vertices.push_back(Vec3{0.0, 0.0, 0.0});
   EXPECT_FALSE(append_pinhole_outline(none, vertices, 16));
   EXPECT_TRUE(none.empty());
+  // Nor with a point that is not finite (a sort by its coordinates would be undefined).
+  vertices.back() = Vec3{std::nan(""), 0.0, 0.5};
+  EXPECT_FALSE(append_pinhole_outline(none, vertices, 16));
+  EXPECT_TRUE(none.empty());
 }
 
 TEST(ProjectedBounds, MarginWidensAndTheImageClips) {
