@@ -32,8 +32,8 @@ void append_segment_in_front(std::vector<Vec3>& points_cam, const Vec3& a, const
 bool append_pinhole_outline(std::vector<Vec3>& points_cam, const std::vector<Vec3>& vertices, int samples) {
   const double near = kNearPlaneM * (1 + 1e-9);
   if (vertices.empty()) return true;
-  // (A non-finite point goes the edges' way too, which bounds it by the whole image; sorting it
-  // here would break the sort's ordering.)
+  // (A non-finite point goes the cut edges' way, as before there was an outline: sorting it here
+  // would break the sort's ordering.)
   for (const Vec3& v : vertices)
     if (!(v[2] > near) || !std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2])) return false;
   // Andrew's monotone chain on the pinhole points, carrying each one's camera-frame vertex.
