@@ -29,7 +29,7 @@ void append_segment_in_front(std::vector<Vec3>& points_cam, const Vec3& a, const
   for (int s = 0; s <= samples; ++s) points_cam.push_back(from + (double(s) / samples) * (to - from));
 }
 
-bool append_pinhole_outline(std::vector<Vec3>& points_cam, const std::vector<Vec3>& vertices, int samples) {
+bool append_pinhole_outline(std::vector<Vec3>& points_cam, std::span<const Vec3> vertices, int samples) {
   const double near = kNearPlaneM * (1 + 1e-9);
   if (vertices.empty()) return true;
   // (A non-finite point goes the cut edges' way, as before there was an outline: sorting it here
@@ -75,7 +75,7 @@ std::optional<PixelRect> projected_box_rect(const CameraModel& camera, const SE3
   points.reserve(12 * (kSamplesPerEdge + 1));
   // In front of the near plane, the outline's edges alone (a convex box's outline is made of its
   // edges); else every edge, cut there.
-  if (append_pinhole_outline(points, std::vector<Vec3>(corners.begin(), corners.end()), kSamplesPerEdge))
+  if (append_pinhole_outline(points, corners, kSamplesPerEdge))
     return projected_points_rect(camera, points, margin_px);
   for (int a = 0; a < 8; ++a)
     for (int bit = 1; bit < 8; bit <<= 1) {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "core/geometry/camera_model.h"
@@ -32,7 +33,7 @@ void append_segment_in_front(std::vector<Vec3>& points_cam, const Vec3& a, const
 // fewer points than all the hull's edges: a box swept along the light and grown by a square has
 // 64 vertices and 192 edges, and its outline about ten. Returns false (appending nothing) when a
 // vertex lies at or behind the near plane or is not finite.
-bool append_pinhole_outline(std::vector<Vec3>& points_cam, const std::vector<Vec3>& vertices, int samples);
+bool append_pinhole_outline(std::vector<Vec3>& points_cam, std::span<const Vec3> vertices, int samples);
 
 // The same for any set of camera-frame points (a shape's edges, sampled densely enough for the
 // lens's bend): their bounding rectangle, widened, clipped; the whole image when some lie behind

@@ -740,6 +740,14 @@ std::optional<std::vector<PixelRect>> RenderStage::shadow_volume_rects(const Cam
       sweep[i] = corners[i];
       sweep[8 + i] = corners[i] - ((corners[i][2] - h) / towards[i][2]) * towards[i];
     }
+    // With sky occlusion, the ground square it darkens too: 2 r about the object's centre.
+    std::vector<Vec3> darkened;
+    if (settings_.shadows.sky_occlusion) {
+      const Vec3 centre = object.T_world_object * (0.5 * (object.bounds.min + object.bounds.max));
+      const double half = 2 * object.sky_radius_m;
+      for (size_t i = 0; i < 4; ++i)
+        darkened.push_back(Vec3{centre[0] + ((i == 1 || i == 2) ? half : -half), centre[1] + (i >= 2 ? half : -half), h});
+    }
     // The sum of the sweep and the square lies in the convex hull of its 64 vertices (each sweep
     // vertex moved to each of the square's corners), and so does the sky occlusion's square: when
     // all lie in front of the near plane, the outline of that hull bounds it (a tenth of the
@@ -747,40 +755,26 @@ std::optional<std::vector<PixelRect>> RenderStage::shadow_volume_rects(const Cam
     std::vector<Vec3> vertices;
     for (const Vec3& vertex : sweep)
       for (const Vec3& shift : square) vertices.push_back(T_cam_world * (vertex + shift));
-    if (settings_.shadows.sky_occlusion) {
-      const Vec3 centre = object.T_world_object * (0.5 * (object.bounds.min + object.bounds.max));
-      const double half = 2 * object.sky_radius_m;
-      for (size_t i = 0; i < 4; ++i)
-        vertices.push_back(T_cam_world * Vec3{centre[0] + ((i == 1 || i == 2) ? half : -half),
-                                              centre[1] + (i >= 2 ? half : -half), h});
-    }
-    if (append_pinhole_outline(points, vertices, kOutlineSamples)) {
-      if (const std::optional<PixelRect> drawn = projected_points_rect(camera, points, kRectMarginPx)) rect = *drawn;
-      continue;
-    }
-    // Some reach behind the near plane: the sum's edges cut there, each of the sweep's edges moved
-    // to each of the square's corners, and the square's edges placed at each of the sweep's vertices.
-    const auto edge = [&](const Vec3& a, const Vec3& b) {
-      append_segment_in_front(points, T_cam_world * a, T_cam_world * b, kSamples);
-    };
-    for (const Vec3& shift : square)
-      for (size_t a = 0; a < 8; ++a) {
-        edge(sweep[a] + shift, sweep[8 + a] + shift);
-        for (size_t bit = 1; bit < 8; bit <<= 1) {
-          if (a & bit) continue;
-          edge(sweep[a] + shift, sweep[a | bit] + shift);
-          edge(sweep[8 + a] + shift, sweep[8 + (a | bit)] + shift);
+    for (const Vec3& corner : darkened) vertices.push_back(T_cam_world * corner);
+    if (!append_pinhole_outline(points, vertices, kOutlineSamples)) {
+      // Some reach behind the near plane: the sum's edges cut there, each of the sweep's edges
+      // moved to each of the square's corners, and the square's edges placed at each of the
+      // sweep's vertices; and the darkened square's edges.
+      const auto edge = [&](const Vec3& a, const Vec3& b) {
+        append_segment_in_front(points, T_cam_world * a, T_cam_world * b, kSamples);
+      };
+      for (const Vec3& shift : square)
+        for (size_t a = 0; a < 8; ++a) {
+          edge(sweep[a] + shift, sweep[8 + a] + shift);
+          for (size_t bit = 1; bit < 8; bit <<= 1) {
+            if (a & bit) continue;
+            edge(sweep[a] + shift, sweep[a | bit] + shift);
+            edge(sweep[8 + a] + shift, sweep[8 + (a | bit)] + shift);
+          }
         }
-      }
-    for (const Vec3& vertex : sweep)
-      for (size_t k = 0; k < 4; ++k) edge(vertex + square[k], vertex + square[(k + 1) % 4]);
-    if (settings_.shadows.sky_occlusion) {  // the ground square it darkens: 2 r about its centre
-      const Vec3 centre = object.T_world_object * (0.5 * (object.bounds.min + object.bounds.max));
-      const double half = 2 * object.sky_radius_m;
-      std::array<Vec3, 4> darkened{};
-      for (size_t i = 0; i < 4; ++i)
-        darkened[i] = Vec3{centre[0] + ((i == 1 || i == 2) ? half : -half), centre[1] + (i >= 2 ? half : -half), h};
-      for (size_t i = 0; i < 4; ++i) edge(darkened[i], darkened[(i + 1) % 4]);
+      for (const Vec3& vertex : sweep)
+        for (size_t k = 0; k < 4; ++k) edge(vertex + square[k], vertex + square[(k + 1) % 4]);
+      for (size_t i = 0; i < darkened.size(); ++i) edge(darkened[i], darkened[(i + 1) % darkened.size()]);
     }
     // Object by object: the hull is convex, their union is not (one beside the camera on the left
     // and one on the right would span the picture). Behind the camera or out of the picture: none.

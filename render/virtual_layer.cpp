@@ -107,10 +107,9 @@ void VirtualLayer::ensure_objects_image(int width, int height) {
   objects_height_ = height;
 }
 
-void VirtualLayer::begin_objects(const WorkArea& area, const PixelRect& rect, const PixelRect& objects_rect) {
+void VirtualLayer::begin_objects(const WorkArea& area, const PixelRect& objects_rect) {
   if (samples_ <= 1) throw RenderError("the objects' own image needs multisampling");
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-  layer_rect_ = rect;  // cleared after the copy (resolve_objects)
   ensure_objects_image(area.width, area.height);
   objects_area_ = area;
   objects_rect_ = objects_rect;
@@ -123,7 +122,7 @@ void VirtualLayer::begin_objects(const WorkArea& area, const PixelRect& rect, co
   glScissor(local.x, local.y, local.width, local.height);
 }
 
-void VirtualLayer::resolve_objects() {
+void VirtualLayer::resolve_objects(const PixelRect& rect) {
   const PixelRect local = objects_area_.local(objects_rect_);
   const PixelRect& to = objects_rect_;
   glDisable(GL_SCISSOR_TEST);
@@ -139,8 +138,8 @@ void VirtualLayer::resolve_objects() {
   // The rest of the layer's rectangle, and what earlier frames left outside it, cleared after the
   // copy rather than before: the clears then join what is drawn there next (the catcher) in one
   // pass of a software rasteriser over its tiles, instead of a pass of their own.
-  clear_written_outside(resolved_framebuffer_.get(), resolved_written_, layer_rect_);
-  PixelRect around_objects = layer_rect_;
+  clear_written_outside(resolved_framebuffer_.get(), resolved_written_, rect);
+  PixelRect around_objects = rect;
   clear_written_outside(resolved_framebuffer_.get(), around_objects, to);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }

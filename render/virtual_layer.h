@@ -30,10 +30,10 @@ class VirtualLayer {
   // image of `area` alone (work_area.h), cleared whole, to draw into with viewport = the canvas
   // placed so that canvas pixel (area.x, area.y) lands on its texel (0, 0), scissor = objects_rect
   // (canvas pixels, within area) seen there. Needs samples() > 1.
-  void begin_objects(const WorkArea& area, const PixelRect& rect, const PixelRect& objects_rect);
+  void begin_objects(const WorkArea& area, const PixelRect& objects_rect);
   // Resolves what was drawn since begin_objects, copies it to its place in texture(), and clears
   // the rest of texture() inside rect (and what earlier frames left outside it, as begin).
-  void resolve_objects();
+  void resolve_objects(const PixelRect& rect);
   // Binds texture()'s framebuffer to draw into, viewport = whole image, scissor = rect.
   void begin_resolved(const PixelRect& rect);
 
@@ -67,7 +67,6 @@ class VirtualLayer {
   GlFramebuffer objects_resolved_framebuffer_;
   WorkArea objects_area_;
   PixelRect objects_rect_;
-  PixelRect layer_rect_;  // begin_objects's rect
   PixelRect resolved_written_;  // what texture() may hold: all of it after allocation  // the multisampled one, or resolved_framebuffer_'s twin with depth
 };
 

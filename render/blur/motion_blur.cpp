@@ -60,14 +60,14 @@ void MotionBlurDrawer::draw_at(VirtualLayer& layer, const LayerDrawRequest& requ
   }
   // Multisampled only where the objects reach, in an image of that area alone; the catcher's wide
   // patch after it, at one sample per pixel.
-  layer.begin_objects(objects_area_, request.rect, request.objects_rect);
+  layer.begin_objects(objects_area_, request.objects_rect);
   pass_times::mark("clear");
   const std::span<const ObjectAtInstant> without_catcher(objects.data(), objects.size() - 1);
   if (!request.ground_hides_nothing) objects_.draw_ground_catcher_depth(request.lens, request.rows, objects.back());
   objects_.draw(request.lens, request.rows, request.lighting, without_catcher, request.objects_rect,
                 request.occluder_lod_px);
   pass_times::mark("objects");
-  layer.resolve_objects();
+  layer.resolve_objects(request.rect);
   pass_times::mark("resolve and copy");
   layer.begin_resolved(request.rect);
   objects_.draw_ground_catcher_under(request.lens, request.rows, request.lighting, objects.back(), request.rect);
