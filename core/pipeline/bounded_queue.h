@@ -1,10 +1,13 @@
 // A bounded multi-producer queue between pipeline threads. Two overflow policies:
 // Block (replay: deterministic, nothing lost) and DropOldest (live: keep latency low, count drops).
+// A dropped item goes to the queue's drop handler when it has one (the pipeline gives a dropped
+// frame's memory back to the source), outside the queue's lock.
 #pragma once
 
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <mutex>
 #include <optional>
 
@@ -15,20 +18,28 @@ enum class OverflowPolicy { Block, DropOldest };
 template <typename T>
 class BoundedQueue {
  public:
-  BoundedQueue(size_t capacity, OverflowPolicy policy) : capacity_(capacity ? capacity : 1), policy_(policy) {}
+  using DropHandler = std::function<void(T&&)>;
+
+  BoundedQueue(size_t capacity, OverflowPolicy policy, DropHandler on_drop = {})
+      : capacity_(capacity ? capacity : 1), policy_(policy), on_drop_(std::move(on_drop)) {}
 
   // Returns false when the queue was closed (the item is discarded).
   bool push(T item) {
-    std::unique_lock lock(mutex_);
-    if (policy_ == OverflowPolicy::Block) {
-      not_full_.wait(lock, [&] { return closed_ || items_.size() < capacity_; });
-    } else if (items_.size() >= capacity_ && !closed_) {
-      items_.pop_front();
-      ++dropped_;
+    std::optional<T> displaced;
+    {
+      std::unique_lock lock(mutex_);
+      if (policy_ == OverflowPolicy::Block) {
+        not_full_.wait(lock, [&] { return closed_ || items_.size() < capacity_; });
+      } else if (items_.size() >= capacity_ && !closed_) {
+        displaced.emplace(std::move(items_.front()));
+        items_.pop_front();
+        ++dropped_;
+      }
+      if (closed_) return false;
+      items_.push_back(std::move(item));
+      not_empty_.notify_one();
     }
-    if (closed_) return false;
-    items_.push_back(std::move(item));
-    not_empty_.notify_one();
+    if (displaced && on_drop_) on_drop_(std::move(*displaced));
     return true;
   }
 
@@ -66,6 +77,7 @@ class BoundedQueue {
   std::deque<T> items_;
   size_t capacity_;
   OverflowPolicy policy_;
+  DropHandler on_drop_;
   bool closed_ = false;
   uint64_t dropped_ = 0;
 };

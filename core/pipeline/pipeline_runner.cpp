@@ -40,8 +40,10 @@ PipelineRunner::~PipelineRunner() {
 void PipelineRunner::start() {
   const size_t depth = size_t(config_.pipeline.queue_depth);
   // Replay must be deterministic frame for frame, so it blocks; a live camera must not fall behind.
+  // A frame a live camera's queue drops gives its memory back to the source, like one the sinks are done with.
   to_process_ = std::make_unique<BoundedQueue<FrameContext>>(
-      depth, source_->is_live() ? OverflowPolicy::DropOldest : OverflowPolicy::Block);
+      depth, source_->is_live() ? OverflowPolicy::DropOldest : OverflowPolicy::Block,
+      [pool = frame_pool_](FrameContext&& dropped) { pool->give(std::move(dropped.camera.data)); });
   to_sink_ = std::make_unique<BoundedQueue<ToSink>>(depth, OverflowPolicy::Block);
   start_ns_ = monotonic_now_ns();
 
@@ -89,6 +91,8 @@ void PipelineRunner::start() {
     processing_thread_.join();
     throw;
   }
+  for (const auto& stage : stages_) held_frames_bound_ += size_t(std::max(0, stage->latency_frames()));
+  frame_pool_->keep_at_most(frames_in_flight_bound(workers.size()));
   {
     std::lock_guard lock(sinks_mutex_);
     sinks_ = std::move(workers);
@@ -143,6 +147,14 @@ void PipelineRunner::capture_loop() {
     if (!to_process_->push(std::move(ctx))) break;
   }
   to_process_->close();
+}
+
+size_t PipelineRunner::frames_in_flight_bound(size_t sink_count) const {
+  const auto depth = size_t(config_.pipeline.queue_depth);
+  // One in each of the capture, processing and sink threads and the stereo packer; the two queues
+  // between them; the sinks' queues hold the newest frames (shared), each sink one it is consuming
+  // and one it may keep (a preview's latest frame).
+  return 4 + 2 * depth + held_frames_bound_ + size_t(config_.pipeline.sink_queue_depth) + 2 * sink_count;
 }
 
 size_t PipelineRunner::first_stage_with_latency() const {
@@ -326,6 +338,8 @@ void PipelineRunner::swap_sinks(SinkSwap& swap) {
       sinks_.push_back(std::move(worker));
     }
   }
+  std::lock_guard lock(sinks_mutex_);
+  frame_pool_->keep_at_most(frames_in_flight_bound(sinks_.size()));
 }
 
 bool PipelineRunner::reconfigure(const Config& config, std::string& error,

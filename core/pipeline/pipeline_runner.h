@@ -88,6 +88,8 @@ class PipelineRunner {
   // On the sink thread, between two frames: closes and starts the sinks a reload changed.
   void swap_sinks(SinkSwap& swap);
   std::unique_ptr<SinkWorker> make_worker(std::string key, std::unique_ptr<FrameSink> sink) const;
+  // The most camera images the running pipeline holds at once: what the frame pool keeps.
+  size_t frames_in_flight_bound(size_t sink_count) const;
 
   // What the sink thread takes, in order: a frame, or the sinks a reload changed.
   struct ToSink {
@@ -98,6 +100,7 @@ class PipelineRunner {
   std::unique_ptr<FrameSource> source_;
   // The camera images' memory, back from the sinks for the source to fill again.
   std::shared_ptr<FramePool> frame_pool_ = std::make_shared<FramePool>();
+  size_t held_frames_bound_ = 0;  // frames the stages with latency hold back, as started
   StageFactory stage_factory_;
   SinkFactory sink_factory_;
   std::vector<SinkSlot> sink_slots_;

@@ -86,6 +86,21 @@ TEST(BoundedQueue, DropOldestKeepsTheNewestItemsAndCountsDrops) {
   EXPECT_EQ(queue.pop(), std::nullopt);
 }
 
+// The drop handler is handed each dropped item, the oldest first, and nothing else: the pipeline
+// gives a dropped frame's memory back to the source through it.
+TEST(BoundedQueue, DropOldestHandsEachDroppedItemToTheDropHandler) {
+  std::vector<std::string> dropped;
+  BoundedQueue<std::string> queue(2, OverflowPolicy::DropOldest, [&](std::string&& s) { dropped.push_back(std::move(s)); });
+  for (int i = 0; i < 5; ++i) EXPECT_TRUE(queue.push(std::to_string(i)));
+  EXPECT_EQ(dropped, (std::vector<std::string>{"0", "1", "2"}));
+  EXPECT_EQ(queue.dropped(), 3u);
+  queue.close();
+  EXPECT_FALSE(queue.push("5"));  // refused after close: not a drop
+  EXPECT_EQ(dropped.size(), 3u);
+  EXPECT_EQ(queue.pop(), "3");
+  EXPECT_EQ(queue.pop(), "4");
+}
+
 TEST(BoundedQueue, DropOldestCountsEveryDropUnderConcurrency) {
   constexpr int kItems = 50'000;
   BoundedQueue<int> queue(2, OverflowPolicy::DropOldest);
