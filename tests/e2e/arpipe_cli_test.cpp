@@ -30,9 +30,10 @@ class ArpipeCli : public ::testing::Test {
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }
-  int run(const std::vector<std::string>& args, std::string* out = nullptr, std::string* err = nullptr) {
+  int run(const std::vector<std::string>& args, std::string* out = nullptr, std::string* err = nullptr,
+          std::chrono::seconds timeout = std::chrono::seconds(120)) {
     test::ChildProcess child(test::build_program("arpipe"), args, dir_ / "logs");
-    const int status = child.wait();
+    const int status = child.wait(timeout);
     if (out) *out = child.stdout_text();
     if (err) *err = child.stderr_text();
     if (status == -1 || !WIFEXITED(status)) return -1;  // a timeout or a crash
@@ -185,7 +186,7 @@ TEST_F(ArpipeCli, BenchHybridRunsTheSeedsProtocolAgainstTheTruth) {
                  (configs / "courtyard.toml").string(), "--work", (dir_ / "hybrid").string(), "--frames", "8",
                  "--truth-views", "2", "--still-samples", "4", "--video-frames", "2", "--video-samples", "1",
                  "--viewpoint", "0,0,1.6", "--viewpoint", "0.5,-0.5,1.6"},
-                &out, &err),
+                &out, &err, std::chrono::seconds(270)),  // 60 s alone; twice that beside the heaviest tests
             0)
       << err;
   EXPECT_NE(out.find("at (0.50, -0.50, 1.60)"), std::string::npos) << out;
