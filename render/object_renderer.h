@@ -53,9 +53,12 @@ struct Lighting {
   std::array<float, 4> catcher_patch{};
   // The ground catcher's ratio baked over its square (render/shadow/catcher_bake.h): a texture
   // whose alpha is what the catcher draws, over world x, y min and max. Texture 0: per pixel.
+  // reach: the part of the square (world x, y min and max) outside which every lookup of the
+  // texture is exactly 0, so the catcher draws nothing there; min > max: nowhere.
   struct BakedCatcher {
     GLuint texture = 0;
     std::array<float, 4> square{};
+    std::array<float, 4> reach{};
   } baked_catcher;
   // The objects no shadow reaches this frame (render/shadow/unshadowed_objects.h): drawn without
   // the shadow lookups, which would all return 1 on them.

@@ -260,6 +260,20 @@ void RenderStage::process(FrameContext& ctx) noexcept {
 
 namespace {
 // Process-wide, so that no two drawings (of this stage or of one built by a reload) share a number.
+// The ground catcher's box where it can draw (object frame): with a bake, the bake's reach (its
+// square stands unrotated, centred on the catcher's origin); nullopt where it draws nothing.
+std::optional<Bounds> catcher_drawn_box(const UploadedObject& catcher, const Lighting::BakedCatcher& baked) {
+  if (baked.texture == 0) return catcher.bounds;
+  const auto& [x0, y0, x1, y1] = baked.reach;
+  if (!(x0 <= x1 && y0 <= y1)) return std::nullopt;
+  const Vec3 origin = catcher.T_world_object.translation();
+  Bounds box = catcher.bounds;
+  box.min[0] = std::max(box.min[0], double(x0) - origin[0]), box.max[0] = std::min(box.max[0], double(x1) - origin[0]);
+  box.min[1] = std::max(box.min[1], double(y0) - origin[1]), box.max[1] = std::min(box.max[1], double(y1) - origin[1]);
+  if (!(box.min[0] <= box.max[0] && box.min[1] <= box.max[1])) return std::nullopt;
+  return box;
+}
+
 uint64_t next_layer_generation() {
   static std::atomic<uint64_t> last{0};
   return ++last;
@@ -393,6 +407,17 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
   request.lighting = frame_lighting(ctx, angular_diameter_rad);
   bool shadow_redrawn = false;
   request.lighting.shadow = shadow_for(ctx, request.lighting, angular_diameter_rad, request.objects, shadow_redrawn);
+  pass_times::set_frame_kind(settings_.msaa_samples, request.lighting.shadow != nullptr);
+  if (request.lighting.shadow && settings_.shadows.bake_catcher) {
+    // Before the footprint, which needs only the part of the catcher its bake says can darken.
+    pass_times::start();
+    if (!catcher_bake_) catcher_bake_ = std::make_unique<CatcherBake>(session_->layer().color_format() == GL_RGBA16F);
+    const UploadedObject& catcher = *request.objects.back();
+    const double focal_px = std::max(canvas_camera.fx(), canvas_camera.fy());
+    request.lighting.baked_catcher = catcher_bake_->for_frame(
+        drawer_->objects(), request.lighting, catcher, catcher_texels_needed(catcher, exposure_poses, focal_px), shadow_redrawn);
+    pass_times::mark("catcher bake");
+  }
   std::vector<PixelRect> each_shadow_rects;  // per present object, where its shadow can fall; empty: unbounded
   if (request.lighting.shadow) {
     // Where the objects' shadows (and the sky they hide) can fall: the receivers join the
@@ -423,10 +448,11 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
     const PixelRect ground_reach =
         settings_.shadows.sky_occlusion ? PixelRect::full(camera.width(), camera.height()) : shadows;
     const UploadedObject& catcher = *request.objects.back();
-    for (const SE3& T_cam_world : exposure_poses)
-      if (std::optional<PixelRect> r =
-              projected_box_rect(image_camera, T_cam_world * catcher.T_world_object, drawn_box(catcher.bounds), kRectMarginPx))
-        rect = rect.united(r->intersected(ground_reach));
+    if (const std::optional<Bounds> box = catcher_drawn_box(catcher, request.lighting.baked_catcher))
+      for (const SE3& T_cam_world : exposure_poses)
+        if (std::optional<PixelRect> r =
+                projected_box_rect(image_camera, T_cam_world * catcher.T_world_object, drawn_box(*box), kRectMarginPx))
+          rect = rect.united(r->intersected(ground_reach));
   }
   if (settings_.full_canvas) rect = PixelRect::full(camera.width(), camera.height());
   request.rect = warp ? warp->canvas_rect_for(rect) : rect;
@@ -474,17 +500,8 @@ RenderStage::Drawn RenderStage::draw(FrameContext& ctx) {
     return Drawn::Reused;
   }
   session_->make_current();
-  pass_times::set_frame_kind(settings_.msaa_samples, request.lighting.shadow != nullptr);
   pass_times::start();
-  if (request.lighting.shadow && settings_.shadows.bake_catcher) {
-    if (!catcher_bake_) catcher_bake_ = std::make_unique<CatcherBake>(session_->layer().color_format() == GL_RGBA16F);
-    const UploadedObject& catcher = *request.objects.back();
-    const double focal_px = std::max(canvas_camera.fx(), canvas_camera.fy());
-    request.lighting.baked_catcher = catcher_bake_->for_frame(
-        drawer_->objects(), request.lighting, catcher, catcher_texels_needed(catcher, exposure_poses, focal_px), shadow_redrawn);
-  }
   VirtualLayer& layer = session_->layer();
-  pass_times::mark("catcher bake");
   const LayerDrawResult drawn = drawer_->draw(layer, request, settings_.blur);
   glDisable(GL_SCISSOR_TEST);
   GLuint drawn_texture = drawn.texture;

@@ -50,6 +50,22 @@ double ground_ambient_luminance(const Lighting& l) {
          0.315392 * 2.0 * luminance(l.ambient_sh[6]);
 }
 
+// The reach (CatcherBake::reach_of) of the bake in the bound framebuffer, read a band of rows at a
+// time (its values as floats: the format every float colour buffer can be read in). The whole
+// square if the read fails.
+std::array<float, 4> read_reach(int size, const std::array<float, 4>& square) {
+  constexpr int kBandRows = 64;
+  std::vector<float> red(size_t(size) * size_t(size)), band(size_t(size) * kBandRows * 4);
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  for (int y = 0; y < size; y += kBandRows) {
+    const int rows = std::min(kBandRows, size - y);
+    glReadPixels(0, y, size, rows, GL_RGBA, GL_FLOAT, band.data());
+    for (size_t i = 0; i < size_t(rows) * size_t(size); ++i) red[size_t(y) * size_t(size) + i] = band[4 * i];
+  }
+  if (glGetError() != GL_NO_ERROR) return square;
+  return CatcherBake::reach_of(red, size, square);
+}
+
 }  // namespace
 
 bool same_catcher_light(const Lighting& a, const Lighting& b) {
@@ -69,6 +85,26 @@ bool same_catcher_light(const Lighting& a, const Lighting& b) {
   for (size_t i = 0; i < a.radiance_sh.size(); ++i)
     if (std::abs(luminance(a.radiance_sh[i]) - luminance(b.radiance_sh[i])) > kCatcherBakeLightChange * largest) return false;
   return true;
+}
+
+std::array<float, 4> CatcherBake::reach_of(std::span<const float> red, int size, const std::array<float, 4>& square) {
+  int x0 = size, x1 = -1, y0 = size, y1 = -1;
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x)
+      if (red[size_t(y) * size_t(size) + size_t(x)] != 0.0f) {
+        x0 = std::min(x0, x), x1 = std::max(x1, x);
+        y0 = std::min(y0, y), y1 = std::max(y1, y);
+      }
+  if (x1 < 0) return {square[2], square[3], square[0], square[1]};  // nothing drawn anywhere
+  // A bilinear lookup at texture coordinate u reads the texels whose centres lie within one texel
+  // of u: zero beyond one texel of the outermost nonzero centre. One texel more covers the
+  // rounding of the lookup's coordinate, which the catcher computes from its pixel's ground point.
+  const auto edge = [&](int texel, float margin, int axis) {
+    const double side = double(square[size_t(axis + 2)]) - double(square[size_t(axis)]);
+    const double at = double(square[size_t(axis)]) + (double(texel) + 0.5 + margin) / double(size) * side;
+    return float(std::clamp(at, double(square[size_t(axis)]), double(square[size_t(axis + 2)])));
+  };
+  return {edge(x0, -2, 0), edge(y0, -2, 1), edge(x1, 2, 0), edge(y1, 2, 1)};
 }
 
 double catcher_texels_needed(const UploadedObject& catcher, std::span<const SE3> T_cam_world, double focal_px) {
@@ -114,7 +150,7 @@ Lighting::BakedCatcher CatcherBake::for_frame(ObjectRenderer& renderer, const Li
   changed_last_frame_ = changed;
   last_key_ = key;
   if (!float_target_ || !lighting.shadow || !(texels_needed <= kMaxCatcherBakeTexels)) return {};
-  if (key.matches(baked_key_) && texels_needed <= size_) return {target_.texture(), square_of(catcher)};
+  if (key.matches(baked_key_) && texels_needed <= size_) return {target_.texture(), square_of(catcher), reach_};
   if (churning) return {};
 
   const int size = std::clamp(static_cast<int>(std::bit_ceil(static_cast<unsigned>(std::ceil(texels_needed)))),
@@ -131,7 +167,9 @@ Lighting::BakedCatcher CatcherBake::for_frame(ObjectRenderer& renderer, const Li
   glDisable(GL_SCISSOR_TEST);
   glBindFramebuffer(GL_FRAMEBUFFER, target_.framebuffer());
   glViewport(0, 0, size, size);
-  renderer.bake_ground_catcher(lighting, catcher, square_of(catcher));
+  const std::array<float, 4> square = square_of(catcher);
+  renderer.bake_ground_catcher(lighting, catcher, square);
+  reach_ = read_reach(size, square);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   check_gl("baking the ground catcher");
   size_ = size;
@@ -139,7 +177,7 @@ Lighting::BakedCatcher CatcherBake::for_frame(ObjectRenderer& renderer, const Li
   ++bakes_;
   log::debug("render: ground catcher baked at {} x {} texels over {:.3f} m ({} texels needed; bake {})", size, size,
              catcher.scale, texels_needed, bakes_);
-  return {target_.texture(), square_of(catcher)};
+  return {target_.texture(), square, reach_};
 }
 
 }  // namespace arpipe

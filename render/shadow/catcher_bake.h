@@ -10,6 +10,11 @@
 // its first frame and never again. The texture holds at least two texels per canvas pixel at the
 // point of the square nearest the camera (baked again, larger, when the camera comes closer), at
 // most kMaxCatcherBakeTexels across (nearer than that, the catcher is drawn per pixel).
+//
+// Each bake is read back once to find its reach: the sky occlusion fades to 0 before the square's
+// edge and a shadow covers part of it, so the catcher draws nothing over much of its square (a
+// third on the default capture, more than half on sun-outdoor), and the frame's footprint needs
+// only the reach (render_stage.cpp).
 #pragma once
 
 #include <cstdint>
@@ -56,6 +61,12 @@ class CatcherBake {
                                    double texels_needed, bool shadow_redrawn);
   uint64_t bakes() const { return bakes_; }  // how many times it baked
 
+  // The part of a bake's square (world x, y min and max, as square) outside which every bilinear
+  // lookup of its texels (size x size, row-major from the square's min corner, red channel) is
+  // exactly 0: the nonzero texels' centres grown by one texel and a margin, within the square.
+  // None nonzero: min > max.
+  static std::array<float, 4> reach_of(std::span<const float> red, int size, const std::array<float, 4>& square);
+
  private:
   // What the bake depends on: the light, compared as the catcher sees it (same_catcher_light), and
   // the rest exactly: the shadow maps, the sky's occluders, the catcher's square.
@@ -70,6 +81,7 @@ class CatcherBake {
   bool float_target_;
   TextureTarget target_;
   int size_ = 0;                       // texels across the baked texture; 0: none yet
+  std::array<float, 4> reach_{};       // the bake's reach (reach_of)
   Key baked_key_;                      // what the texture was baked from
   Key last_key_;                       // the last frame's inputs
   bool changed_last_frame_ = false;

@@ -80,6 +80,120 @@ TEST(CatcherBake, BakesOnceForAStillLightAndLeavesAChurningOneToThePerPixelPath)
   EXPECT_EQ(CatcherBake(false).for_frame(renderer, lighting, catcher, 300, false).texture, 0u) << "no float target";
 }
 
+// GL's bilinear lookup of a size x size red texture at texture coordinate (u, v), clamped to the
+// edge: what the baked catcher's shader reads.
+double bilinear(const std::vector<float>& red, int size, double u, double v) {
+  const double x = u * size - 0.5, y = v * size - 0.5;
+  const int x0 = int(std::floor(x)), y0 = int(std::floor(y));
+  const double fx = x - x0, fy = y - y0;
+  const auto texel = [&](int i, int j) {
+    i = std::clamp(i, 0, size - 1), j = std::clamp(j, 0, size - 1);
+    return double(red[size_t(j) * size_t(size) + size_t(i)]);
+  };
+  return (1 - fy) * ((1 - fx) * texel(x0, y0) + fx * texel(x0 + 1, y0)) +
+         fy * ((1 - fx) * texel(x0, y0 + 1) + fx * texel(x0 + 1, y0 + 1));
+}
+
+// The reach holds every lookup that is not exactly 0: a blob of nonzero texels (one at the
+// square's edge on one side), then every point of a fine grid over the square outside the reach
+// reads 0, and the nonzero texels' centres are inside it.
+TEST(CatcherBake, TheReachHoldsEveryLookupThatIsNotZero) {
+  constexpr int kSize = 64;
+  const std::array<float, 4> square{-0.3f, 0.1f, 0.5f, 0.9f};  // 0.8 m a side
+  std::vector<float> red(kSize * kSize, 0.0f);
+  for (int y = 20; y <= 30; ++y)
+    for (int x = 0; x <= 12; ++x) red[size_t(y) * kSize + size_t(x)] = 1e-4f * float(1 + x + y);
+  red[size_t(40) * kSize + 25] = 0.5f;  // a lone texel
+  const std::array<float, 4> reach = CatcherBake::reach_of(red, kSize, square);
+  const double texel = 0.8 / kSize;
+  EXPECT_FLOAT_EQ(reach[0], square[0]) << "clamped to the square";
+  EXPECT_NEAR(reach[2], square[0] + (25.5 + 2) * texel, 1e-6);
+  EXPECT_NEAR(reach[1], square[1] + (20.5 - 2) * texel, 1e-6);
+  EXPECT_NEAR(reach[3], square[1] + (40.5 + 2) * texel, 1e-6);
+  int outside = 0;
+  for (int j = 0; j <= 800; ++j)
+    for (int i = 0; i <= 800; ++i) {
+      const double u = i / 800.0, v = j / 800.0;
+      const double wx = square[0] + u * 0.8, wy = square[1] + v * 0.8;
+      if (wx >= reach[0] && wx <= reach[2] && wy >= reach[1] && wy <= reach[3]) continue;
+      ++outside;
+      ASSERT_EQ(bilinear(red, kSize, u, v), 0.0) << "at (" << wx << ", " << wy << ")";
+    }
+  EXPECT_GT(outside, 300000) << "most of the square is outside the reach";
+  // Nothing nonzero: no reach.
+  const std::array<float, 4> none = CatcherBake::reach_of(std::vector<float>(kSize * kSize, 0.0f), kSize, square);
+  EXPECT_GT(none[0], none[2]);
+  EXPECT_GT(none[1], none[3]);
+}
+
+// A real bake's reach, read back by the bake itself: one virtual object hiding part of the sky at
+// the square's centre darkens the ground around it, by a share that falls with the cube of the
+// distance. Under a sky 10^4 times fainter than the sun (the shadow's own ratio then moves by
+// less than float's resolution beyond ~0.1 m), the darkening is exactly 0 well inside the square.
+// Every texel of the texture that is not 0 has its centre inside the reach, and the reach is the
+// bounds of those centres grown by 2 texels at most. A lit ground with nothing over it has no reach.
+TEST(CatcherBake, ARealBakesReachHoldsItsNonzeroTexels) {
+  EglContext context(EglPlatformRequest::Auto);
+  ObjectRenderer renderer;
+  ShadowReceiver receiver(1);
+  ReceiverPatch patch;
+  patch.min = {-0.2, -0.2};
+  patch.max = {0.2, 0.2};
+  const UploadedObject& catcher = receiver.over(patch);
+  ShadowLookup lookup;
+  lookup.method = ShadowMethod::Hard;
+  Lighting lighting;
+  lighting.shadow = &lookup;
+  lighting.direction = {0, 0, 1};
+  lighting.color = {1, 1, 1};
+  lighting.ambient = {1e-4, 1e-4, 1e-4};
+  lighting.radiance_sh[0] = {1e-4, 1e-4, 1e-4};
+  lighting.sky_occluders = {{0.0f, 0.0f, 0.01f, 0.01f}};
+  lighting.catcher_patch = {-0.2f, -0.2f, 0.2f, 0.2f};
+  CatcherBake bake(true);
+  constexpr int kSize = 256;  // 200 texels needed: the next power of two
+  const Lighting::BakedCatcher baked = bake.for_frame(renderer, lighting, catcher, 200, false);
+  ASSERT_NE(baked.texture, 0u);
+  const auto& r = baked.reach;
+  std::printf("reach x %.4f..%.4f, y %.4f..%.4f of the square -0.2..0.2\n", r[0], r[2], r[1], r[3]);
+
+  // The texture as the catcher reads it.
+  GlFramebuffer framebuffer = create_framebuffer_for(baked.texture);
+  glBindFramebuffer(GL_FRAMEBUFFER, framebuffer.get());
+  std::vector<float> rgba(size_t(kSize) * kSize * 4);
+  glReadPixels(0, 0, kSize, kSize, GL_RGBA, GL_FLOAT, rgba.data());
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  ASSERT_EQ(glGetError(), GLenum(GL_NO_ERROR));
+  const double texel = 0.4 / kSize;
+  double lo[2] = {1, 1}, hi[2] = {-1, -1};
+  size_t nonzero = 0;
+  for (int y = 0; y < kSize; ++y)
+    for (int x = 0; x < kSize; ++x)
+      if (rgba[(size_t(y) * kSize + size_t(x)) * 4] != 0.0f) {
+        ++nonzero;
+        const double c[2] = {-0.2 + (x + 0.5) * texel, -0.2 + (y + 0.5) * texel};
+        for (int a = 0; a < 2; ++a) lo[a] = std::min(lo[a], c[a]), hi[a] = std::max(hi[a], c[a]);
+      }
+  ASSERT_GT(nonzero, 100u) << "the occluder darkens the ground";
+  for (int a = 0; a < 2; ++a) {
+    EXPECT_GT(lo[a], -0.18) << "the darkening ends inside the square";
+    EXPECT_LT(hi[a], 0.18) << "the darkening ends inside the square";
+  }
+  for (int a = 0; a < 2; ++a) {
+    // (The square's edge clamps it: nothing reads beyond the square.)
+    EXPECT_LE(r[size_t(a)], std::max(-0.2, lo[a] - 0.99 * texel) + 1e-6);
+    EXPECT_GE(r[size_t(a)], std::max(-0.2, lo[a] - 2.01 * texel) - 1e-6);
+    EXPECT_GE(r[size_t(a + 2)], std::min(0.2, hi[a] + 0.99 * texel) - 1e-6);
+    EXPECT_LE(r[size_t(a + 2)], std::min(0.2, hi[a] + 2.01 * texel) + 1e-6);
+  }
+
+  EXPECT_NE(bake.for_frame(renderer, lighting, catcher, 200, false).texture, 0u);  // a still frame
+  lighting.sky_occluders.clear();
+  const Lighting::BakedCatcher lit = bake.for_frame(renderer, lighting, catcher, 200, false);
+  ASSERT_NE(lit.texture, 0u);
+  EXPECT_GT(lit.reach[0], lit.reach[2]) << "nothing drawn: no reach";
+}
+
 // Through the render stage: a cube under a low light (a long shadow with a wide penumbra), seen
 // from three places, with the catcher baked and drawn per pixel. The bake holds two texels per
 // pixel and is read back filtered: it blurs the shadow's edges (the contact shadow at the cube's
