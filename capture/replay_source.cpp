@@ -4,9 +4,11 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <atomic>
 #include <limits>
 #include <optional>
+#include <vector>
 
 #include "capture/pacing_clock.h"
 #include "capture/recording/recording_reader.h"
@@ -49,10 +51,33 @@ struct ReplaySource::Impl {
   uint64_t passes = 0;
   std::atomic<uint64_t> skipped{0};
   PacingClock clock;
+  // A looped recording's frames as the first pass read and checked them (unshifted), while they
+  // fit source.loop_cache_mb: later passes copy them as a camera's driver buffer is copied,
+  // instead of reading and checksumming the file again. A frame that failed its check has none.
+  std::vector<std::optional<Frame>> loop_cache;
+  size_t loop_cache_bytes = 0;
+  bool loop_cache_full = false;  // over the budget: dropped, and every pass reads the file
 
   explicit Impl(const SourceConfig& c) : config(c), reader(open_recording(c.path)) {}
   SourceStatus next(Frame& frame);
+  void keep_for_later_passes(size_t index, const Frame& frame);
 };
+
+void ReplaySource::Impl::keep_for_later_passes(size_t index, const Frame& frame) {
+  const size_t budget = size_t(std::max(config.loop_cache_mb, 0)) << 20;
+  if (loop_cache_bytes + frame.data.size() > budget) {
+    if (config.loop_cache_mb > 0)
+      log::info("replay {}: its frames exceed source.loop_cache_mb ({} MiB); every pass reads them from the file",
+                config.path.string(), config.loop_cache_mb);
+    loop_cache.clear();
+    loop_cache.shrink_to_fit();
+    loop_cache_full = true;
+    return;
+  }
+  loop_cache.resize(reader.frame_count());
+  loop_cache[index] = frame;
+  loop_cache_bytes += frame.data.size();
+}
 
 ReplaySource::ReplaySource(const SourceConfig& config) : impl_(std::make_unique<Impl>(config)) {
   Impl& s = *impl_;
@@ -149,12 +174,17 @@ SourceStatus ReplaySource::Impl::next(Frame& frame) {
   if (s.paced && !s.clock.wait(*due_ns)) return SourceStatus::Retry;
 
   s.next_index = index + 1;
-  try {
-    s.reader.read(index, frame);
-  } catch (const std::exception& e) {
-    ++s.skipped;
-    log::warn("replay {}: frame {} skipped: {}", s.config.path.string(), index, e.what());
-    return SourceStatus::Retry;
+  if (s.passes > 0 && index < s.loop_cache.size() && s.loop_cache[index]) {
+    frame = *s.loop_cache[index];  // copy assignment keeps frame's (recycled) memory when it holds enough
+  } else {
+    try {
+      s.reader.read(index, frame);
+    } catch (const std::exception& e) {
+      ++s.skipped;
+      log::warn("replay {}: frame {} skipped: {}", s.config.path.string(), index, e.what());
+      return SourceStatus::Retry;
+    }
+    if (s.config.loop && s.passes == 0 && !s.loop_cache_full) keep_for_later_passes(index, frame);
   }
   frame.meta.exposure_start_ns = *shifted;
   frame.meta.timestamp_offset_ns += s.config.timestamp_offset_ns;

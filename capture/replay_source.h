@@ -25,7 +25,9 @@ class ReplaySource : public FrameSource {
   // duration plus one frame interval per pass to the timestamps (and its frame count to the
   // sequence numbers), so time and sequence never go backwards. A frame that fails its checksum
   // is logged, counted and skipped (Retry); an interrupt() during a pacing sleep returns Retry
-  // and the frame comes with the next call.
+  // and the frame comes with the next call. A looped recording whose frames fit
+  // source.loop_cache_mb is read and checked on its first pass only: later passes copy the frames
+  // kept from it (a change to the files during the replay is then not seen).
   // The recording's frame duration, else the mean spacing of its frames; nullopt for fewer than two
   // frames without a duration.
   std::optional<int64_t> frame_interval_ns() const override;

@@ -42,6 +42,7 @@ struct SourceConfig {
   std::filesystem::path path;           // replay: the recording directory
   ReplayPacing pacing = ReplayPacing::Timestamps;  // replay only
   bool loop = false;                    // replay: start again at the end (soak tests)
+  int loop_cache_mb = 64;               // replay with loop: frames kept in memory after their first pass
   int64_t timestamp_offset_ns = 0;      // added to every exposure_start_ns of this camera
   std::filesystem::path camera_model;   // overrides the recording's camera model; live: required to track
 
@@ -78,6 +79,9 @@ void visit(V& v, SourceConfig& s) {
   v.key("path", s.path, "replay: the recording directory");
   v.key("pacing", s.pacing, kReplayPacingNames, "replay: real time, or as fast as the pipeline runs");
   v.key("loop", s.loop, "replay: start again at the end (soak tests)");
+  v.key("loop_cache_mb", s.loop_cache_mb, IntRange{0, 65536},
+        "replay with loop: a recording whose frames fit in this many MiB is read and checked once and its "
+        "later passes come from memory; 0: read and checked every pass");
   // Drivers disagree about their timestamps by a frame or two; an hour keeps every exposure time
   // plus the offset inside int64 nanoseconds.
   v.key("timestamp_offset_ns", s.timestamp_offset_ns, IntRange{-3'600'000'000'000, 3'600'000'000'000},

@@ -162,6 +162,79 @@ TEST(ReplaySource, DamagedFrameIsSkippedAndCounted) {
   EXPECT_EQ(source.frames_skipped(), 1u);
 }
 
+// Flips one byte of frame `index`'s pixels in frames.bin (GREY frames of `frame_bytes` each).
+void damage_frame(const fs::path& dir, size_t index, size_t frame_bytes) {
+  std::string frames = read_file(dir / "frames.bin");
+  frames[index * frame_bytes + 5] = char(frames[index * frame_bytes + 5] ^ 1);
+  write_file(dir / "frames.bin", frames);
+}
+
+// What a looped replay delivers over three passes of a 4-frame recording, damaged on disk after
+// the first pass: each frame's first pixel (-1: skipped).
+std::vector<int> three_passes_damaged_after_the_first(const fs::path& dir, int loop_cache_mb, uint64_t& skipped) {
+  SourceConfig config = replay_config(dir, ReplayPacing::Fast, true);
+  config.loop_cache_mb = loop_cache_mb;
+  ReplaySource source(config);
+  std::vector<int> got;
+  for (int k = 0; k < 12; ++k) {
+    if (k == 4) damage_frame(dir, 1, 128);
+    Frame frame;
+    got.push_back(source.next(frame) == SourceStatus::Frame ? int(frame.meta.sequence) : -1);
+  }
+  skipped = source.frames_skipped();
+  return got;
+}
+
+// source.loop_cache_mb: a looped recording that fits is read and checked on its first pass only;
+// later passes are the frames that pass delivered (a change to the file is not seen). Over the
+// budget, or with 0, every pass reads and checks the file: the damage is seen and counted.
+TEST(ReplaySource, ALoopedRecordingThatFitsIsReadAndCheckedOnce) {
+  // random_frame's sequences are 100, 102, 104, 106; a pass adds 7 (the span plus one).
+  const std::vector<int> clean{100, 102, 104, 106, 107, 109, 111, 113, 114, 116, 118, 120};
+  uint64_t skipped = 0;
+  const fs::path cached = scratch_dir("replay-loop-cache");
+  write_recording(cached, PixelFormat::GREY, 16, 8, 4);
+  EXPECT_EQ(three_passes_damaged_after_the_first(cached, 1, skipped), clean);
+  EXPECT_EQ(skipped, 0u);
+
+  const std::vector<int> damaged{100, 102, 104, 106, 107, -1, 111, 113, 114, -1, 118, 120};
+  const fs::path uncached = scratch_dir("replay-loop-uncached");
+  write_recording(uncached, PixelFormat::GREY, 16, 8, 4);
+  EXPECT_EQ(three_passes_damaged_after_the_first(uncached, 0, skipped), damaged);
+  EXPECT_EQ(skipped, 2u);
+}
+
+TEST(ReplaySource, ALoopedRecordingOverTheBudgetIsReadEveryPass) {
+  const fs::path dir = scratch_dir("replay-loop-over-budget");
+  write_recording(dir, PixelFormat::GREY, 1024, 512, 3);  // 1.5 MiB of frames
+  SourceConfig config = replay_config(dir, ReplayPacing::Fast, true);
+  config.loop_cache_mb = 1;
+  ReplaySource source(config);
+  for (int k = 0; k < 3; ++k) {
+    Frame frame;
+    ASSERT_EQ(source.next(frame), SourceStatus::Frame);
+  }
+  damage_frame(dir, 0, 1024 * 512);
+  Frame frame;
+  EXPECT_EQ(source.next(frame), SourceStatus::Retry) << "read from the file again";
+  EXPECT_EQ(source.frames_skipped(), 1u);
+}
+
+// A frame damaged from the start is skipped on every pass, cached or not.
+TEST(ReplaySource, AFrameDamagedFromTheStartIsSkippedOnEveryPass) {
+  const fs::path dir = scratch_dir("replay-loop-damaged");
+  write_recording(dir, PixelFormat::GREY, 16, 8, 4);
+  damage_frame(dir, 2, 128);
+  ReplaySource source(replay_config(dir, ReplayPacing::Fast, true));
+  std::vector<int> got;
+  for (int k = 0; k < 8; ++k) {
+    Frame frame;
+    got.push_back(source.next(frame) == SourceStatus::Frame ? int(frame.meta.sequence) : -1);
+  }
+  EXPECT_EQ(got, (std::vector<int>{100, 102, -1, 106, 107, 109, -1, 113}));
+  EXPECT_EQ(source.frames_skipped(), 2u);
+}
+
 TEST(ReplaySource, CameraModelOverrideOfTheSameSizeIsUsed) {
   const fs::path dir = scratch_dir("replay-override");
   write_recording(dir, PixelFormat::GREY, 16, 8, 1);
