@@ -147,7 +147,7 @@ struct TagTracker::Impl {
   // The last detection's tags' patch and pose (track.still_px), while frames since are tracked.
   struct StillReference {
     PixelRect box;
-    SmoothedPatch luma;  // box.width x box.height, smoothed once for patch_motion
+    SmoothedPatch smoothed;  // its luma, box.width x box.height, smoothed once for patch_motion
     PoseEstimate pose;
     std::optional<std::array<double, 4>> bundle_box;  // x0, y0, x1, y1 of the bundle projected with pose
   };
@@ -334,7 +334,7 @@ bool TagTracker::Impl::keep_still_pose(FrameContext& ctx, const std::optional<SE
   if (needs_luma) pixels = luma(frame, box);
   const uint8_t* current = pixels + size_t(box.y) * stride + size_t(box.x);
   const std::optional<PatchMotion> motion =
-      patch_motion(still->luma, current, stride);
+      patch_motion(still->smoothed, current, stride);
   // More than this share of pixels the motion cannot explain: something crossed the tags. More
   // than this change of contrast: not the same picture (a flat one fits with a gain of -1), or an
   // exposure step worth detecting again.
