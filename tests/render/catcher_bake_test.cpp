@@ -32,22 +32,30 @@ TEST(CatcherBake, TexelsNeededAreTwicePerPixelAtTheNearestPoint) {
   EXPECT_TRUE(std::isinf(catcher_texels_needed(catcher, on_it, 600.0)));
 }
 
-// The bake's policy on hand-made inputs: a shadow lookup of no texture (reads nothing, so every
-// ground point is lit) is enough to drive it.
-TEST(CatcherBake, BakesOnceForAStillLightAndLeavesAChurningOneToThePerPixelPath) {
-  EglContext context(EglPlatformRequest::Auto);
+// Hand-made inputs that drive a bake: a GL context, the renderer, a ground catcher over the square
+// of half-side `half` centred at the origin, and a shadow lookup of no texture (reads nothing, so
+// every ground point is lit).
+struct BakeInputs {
+  explicit BakeInputs(double half) : catcher(receiver.over(ReceiverPatch{0, {-half, -half}, {half, half}})) {
+    lookup.method = ShadowMethod::Hard;
+    lighting.shadow = &lookup;
+    lighting.color = {1, 1, 1};
+    lighting.ambient = {0.3, 0.3, 0.3};
+  }
+  EglContext context{EglPlatformRequest::Auto};
   ObjectRenderer renderer;
-  ShadowReceiver receiver(1);
-  ReceiverPatch patch;
-  patch.min = {-0.1, -0.1};
-  patch.max = {0.1, 0.1};
-  const UploadedObject& catcher = receiver.over(patch);
+  ShadowReceiver receiver{1};
+  const UploadedObject& catcher;
   ShadowLookup lookup;
-  lookup.method = ShadowMethod::Hard;
   Lighting lighting;
-  lighting.shadow = &lookup;
-  lighting.color = {1, 1, 1};
-  lighting.ambient = {0.3, 0.3, 0.3};
+};
+
+// The bake's policy.
+TEST(CatcherBake, BakesOnceForAStillLightAndLeavesAChurningOneToThePerPixelPath) {
+  BakeInputs inputs(0.1);
+  ObjectRenderer& renderer = inputs.renderer;
+  const UploadedObject& catcher = inputs.catcher;
+  Lighting& lighting = inputs.lighting;
   CatcherBake bake(true);
 
   Lighting::BakedCatcher baked = bake.for_frame(renderer, lighting, catcher, 300, false);
@@ -133,19 +141,11 @@ TEST(CatcherBake, TheReachHoldsEveryLookupThatIsNotZero) {
 // Every texel of the texture that is not 0 has its centre inside the reach, and the reach is the
 // bounds of those centres grown by 2 texels at most. A lit ground with nothing over it has no reach.
 TEST(CatcherBake, ARealBakesReachHoldsItsNonzeroTexels) {
-  EglContext context(EglPlatformRequest::Auto);
-  ObjectRenderer renderer;
-  ShadowReceiver receiver(1);
-  ReceiverPatch patch;
-  patch.min = {-0.2, -0.2};
-  patch.max = {0.2, 0.2};
-  const UploadedObject& catcher = receiver.over(patch);
-  ShadowLookup lookup;
-  lookup.method = ShadowMethod::Hard;
-  Lighting lighting;
-  lighting.shadow = &lookup;
+  BakeInputs inputs(0.2);
+  ObjectRenderer& renderer = inputs.renderer;
+  const UploadedObject& catcher = inputs.catcher;
+  Lighting& lighting = inputs.lighting;
   lighting.direction = {0, 0, 1};
-  lighting.color = {1, 1, 1};
   lighting.ambient = {1e-4, 1e-4, 1e-4};
   lighting.radiance_sh[0] = {1e-4, 1e-4, 1e-4};
   lighting.sky_occluders = {{0.0f, 0.0f, 0.01f, 0.01f}};
