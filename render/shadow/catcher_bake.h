@@ -6,7 +6,8 @@
 //
 // When to bake: when the inputs changed since the last bake (the light by more than
 // same_catcher_light allows), unless they also changed on the frame before (a light estimated anew each frame, a moving caster): then the catcher is drawn
-// per pixel, which costs less than a bake a frame. So a still light over a still scene bakes on
+// per pixel, which costs less than a bake a frame. (The render stage asks on every frame with a
+// shadow, a reused layer's too, so "the frame before" is the last frame, drawn or not.) So a still light over a still scene bakes on
 // its first frame and never again. The texture holds at least two texels per canvas pixel at the
 // point of the square nearest the camera (baked again, larger, when the camera comes closer), at
 // most kMaxCatcherBakeTexels across (nearer than that, the catcher is drawn per pixel).
