@@ -259,7 +259,6 @@ void RenderStage::process(FrameContext& ctx) noexcept {
 }
 
 namespace {
-// Process-wide, so that no two drawings (of this stage or of one built by a reload) share a number.
 // The ground catcher's box where it can draw (object frame): with a bake, the bake's reach (its
 // square stands unrotated, centred on the catcher's origin); nullopt where it draws nothing.
 std::optional<Bounds> catcher_drawn_box(const UploadedObject& catcher, const Lighting::BakedCatcher& baked) {
@@ -274,6 +273,7 @@ std::optional<Bounds> catcher_drawn_box(const UploadedObject& catcher, const Lig
   return box;
 }
 
+// Process-wide, so that no two drawings (of this stage or of one built by a reload) share a number.
 uint64_t next_layer_generation() {
   static std::atomic<uint64_t> last{0};
   return ++last;
