@@ -39,9 +39,10 @@ inline constexpr int kMaxCatcherBakeTexels = 1024;
 // of the ambient light at the ground's normal A and, with sky occlusion, of the ambient radiance's
 // SH; moving A and D by dA and dD moves it by at most (D |dA| + A |dD|) / (A + D)^2, which is at
 // most e when each moves by at most e times the larger of the two. So each may move by
-// kCatcherBakeLightChange of the larger (the SH by that share of its largest coefficient), the
-// direction and a lamp's place by the layer reuse's 1e-4 (render/layer_reuse.h); the shadow maps
-// must be the same.
+// kCatcherBakeLightChange of the larger (the SH by that share of its largest coefficient). A light
+// infinitely far reaches D only through its cosine on the ground (the ground's normal is up), so
+// its direction counts only there; a lamp's direction and place may move by the layer reuse's
+// 1e-4 (render/layer_reuse.h). The shadow maps must be the same.
 inline constexpr double kCatcherBakeLightChange = 1e-3;
 bool same_catcher_light(const Lighting& a, const Lighting& b);
 

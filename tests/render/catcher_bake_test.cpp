@@ -11,6 +11,7 @@
 
 #include "render/gl/egl_context.h"
 #include "render/shadow/shadow_receiver.h"
+#include "gl_readback.h"
 #include "render_test_support.h"
 
 namespace arpipe {
@@ -86,6 +87,67 @@ TEST(CatcherBake, BakesOnceForAStillLightAndLeavesAChurningOneToThePerPixelPath)
   EXPECT_EQ(bake.for_frame(renderer, lighting, catcher, kMaxCatcherBakeTexels + 1, false).texture, 0u)
       << "too close for a bake: per pixel";
   EXPECT_EQ(CatcherBake(false).for_frame(renderer, lighting, catcher, 300, false).texture, 0u) << "no float target";
+}
+
+// A light infinitely far reaches the catcher's ratio through its cosine on the ground alone (the
+// shadow maps are compared apart): turned around the vertical it needs no new bake, and a bake
+// made afresh under the turned light holds the same texels within the key's 1/1000 (they are the
+// same: the shader's cosine is the direction's z). A light that changes that cosine by 2 % is baked
+// anew, and its bake differs by more than 1/1000; a lamp is still compared by its place.
+TEST(CatcherBake, AFarLightCountsOnlyThroughItsCosineOnTheGround) {
+  BakeInputs inputs(0.2);
+  ObjectRenderer& renderer = inputs.renderer;
+  const UploadedObject& catcher = inputs.catcher;
+  Lighting& lighting = inputs.lighting;
+  lighting.radiance_sh[0] = {0.3, 0.3, 0.3};
+  lighting.sky_occluders = {{0.0f, 0.0f, 0.03f, 0.03f}};  // darkens the ground by the direct light's share
+  lighting.catcher_patch = {-0.2f, -0.2f, 0.2f, 0.2f};
+  constexpr int kSize = 256;  // 200 texels needed: the next power of two
+  const auto texels = [&](const Lighting::BakedCatcher& baked) {
+    std::vector<float> rgba = read_rgba_float(baked.texture, kSize, kSize);
+    std::vector<float> red(size_t(kSize) * kSize);
+    for (size_t i = 0; i < red.size(); ++i) red[i] = rgba[4 * i];
+    return red;
+  };
+  const auto largest_difference = [](const std::vector<float>& a, const std::vector<float>& b) {
+    double d = 0;
+    for (size_t i = 0; i < a.size(); ++i) d = std::max(d, std::abs(double(a[i]) - double(b[i])));
+    return d;
+  };
+
+  lighting.direction = normalized(Vec3{0.3, -0.4, 1.0});
+  CatcherBake bake(true);
+  const Lighting::BakedCatcher first = bake.for_frame(renderer, lighting, catcher, 200, false);
+  ASSERT_NE(first.texture, 0u);
+  const std::vector<float> before = texels(first);
+  ASSERT_GT(std::count_if(before.begin(), before.end(), [](float v) { return v > 0.01f; }), 100)
+      << "the occluder darkens the ground";
+
+  lighting.direction = normalized(Vec3{0.4, 0.3, 1.0});  // turned 90 degrees around the vertical
+  ASSERT_NE(bake.for_frame(renderer, lighting, catcher, 200, false).texture, 0u);
+  EXPECT_EQ(bake.bakes(), 1u) << "the same cosine on the ground: the bake serves";
+  CatcherBake fresh(true);
+  const std::vector<float> turned = texels(fresh.for_frame(renderer, lighting, catcher, 200, false));
+  EXPECT_LE(largest_difference(before, turned), kCatcherBakeLightChange);
+
+  lighting.direction = normalized(Vec3{0.3, -0.4, 0.9});  // its cosine on the ground 2.3 % larger
+  ASSERT_NE(bake.for_frame(renderer, lighting, catcher, 200, false).texture, 0u);
+  EXPECT_EQ(bake.bakes(), 2u) << "another cosine on the ground: baked anew";
+  CatcherBake steeper(true);
+  EXPECT_GT(largest_difference(before, texels(steeper.for_frame(renderer, lighting, catcher, 200, false))),
+            kCatcherBakeLightChange);
+
+  // A lamp: its place is compared.
+  lighting.local = true;
+  lighting.position = {0.1, 0.0, 0.5};
+  lighting.direction = normalized(lighting.position);
+  CatcherBake lamp(true);
+  ASSERT_NE(lamp.for_frame(renderer, lighting, catcher, 200, false).texture, 0u);
+  ASSERT_NE(lamp.for_frame(renderer, lighting, catcher, 200, false).texture, 0u);
+  EXPECT_EQ(lamp.bakes(), 1u);
+  lighting.position = {0.1, 0.001, 0.5};  // 1 mm aside
+  ASSERT_NE(lamp.for_frame(renderer, lighting, catcher, 200, false).texture, 0u);
+  EXPECT_EQ(lamp.bakes(), 2u) << "a lamp that moved is baked anew";
 }
 
 // GL's bilinear lookup of a size x size red texture at texture coordinate (u, v), clamped to the
