@@ -38,6 +38,9 @@ class CompositeStage final : public Stage {
   // the generation read last. Without a virtual layer this frame, no GL at all. On an error: the
   // camera frame as it was.
   void process(FrameContext& ctx) noexcept override;
+  // Converts the camera frame to RGB24 (ctx.camera_rgb24), which the frame's process() then takes
+  // instead of converting it there; not with render.lens = "undistort".
+  void process_ahead(FrameContext& ctx) noexcept override;
 
  private:
   void camera_picture(FrameContext& ctx);

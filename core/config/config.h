@@ -893,7 +893,7 @@ void visit(V& v, PipelineConfig& s) {
   v.key("max_frames", s.max_frames, IntRange{0}, "stop after this many frames; 0 = no limit");
   v.key("log_level", s.log_level, kLogLevelNames, "what the daemon logs");
   v.key("overlap_first_stage", s.overlap_first_stage,
-        "track the next waiting frame on a helper thread while the last one renders");
+        "track the next waiting frame (and convert its camera picture) on a helper thread while the last one renders");
 }
 
 // The daemon's control socket (arpipe ctl: status, reload, set, snapshot, record).

@@ -89,6 +89,10 @@ struct FrameContext {
   // config's fixed light.
   LightEstimate light;
   Frame output;                                 // the composited frame, RGB24; empty until composed
+  // The camera frame as it was, RGB24, converted ahead of the composite stage on the helper thread
+  // (pipeline.overlap_first_stage; Stage::process_ahead), and how long that took; empty when not.
+  Frame camera_rgb24;
+  double camera_rgb24_ms = 0;
   // The lens that ctx.output is seen through: camera_model, or its pinhole core when render.lens
   // is "undistort" (the output is then an undistorted picture). Set with ctx.output.
   std::shared_ptr<const CameraModel> output_camera_model;

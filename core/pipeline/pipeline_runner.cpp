@@ -7,8 +7,10 @@
 #include <deque>
 #include <exception>
 #include <future>
+#include <optional>
 
 #include "core/log.h"
+#include "core/pipeline/helper_thread.h"
 #include "core/pipeline/monotonic_clock.h"
 
 namespace arpipe {
@@ -197,6 +199,11 @@ void PipelineRunner::processing_loop() {
       finish_frame(ctx, split);
     }
   };
+  // A frame's first stage, and what the later stages do ahead (Stage::process_ahead).
+  const auto run_ahead = [&](FrameContext& ctx) {
+    stages_[0]->process(ctx);
+    for (size_t i = 1; i < stages_.size(); ++i) stages_[i]->process_ahead(ctx);
+  };
   // Whether the first stage may run on its own, ahead of the others (see below).
   const auto first_runs_ahead = [&] {
     return config_.pipeline.overlap_first_stage && !stages_.empty() && stages_[0]->can_run_ahead() &&
@@ -208,6 +215,7 @@ void PipelineRunner::processing_loop() {
   // one. Each stage still sees the frames in order. A frame with nothing queued behind it goes on
   // at once, so a live camera's frames wait for no later frame.
   std::optional<FrameContext> waiting;
+  std::optional<HelperThread> helper;  // started at the first overlap
   while (auto ctx = to_process_->pop()) {
     busy_since_ns_ = monotonic_now_ns();
     // Frames the live queue dropped are lost just like a sequence gap, so the next frame says so.
@@ -221,9 +229,10 @@ void PipelineRunner::processing_loop() {
     }
     if (waiting) {
       FrameContext& next = *ctx;
-      std::future<void> first = std::async(std::launch::async, [&] { stages_[0]->process(next); });
+      if (!helper) helper.emplace();
+      helper->start([&] { run_ahead(next); });
       run_from(*waiting, 1);
-      first.wait();
+      helper->wait();
       waiting.reset();
       {
         std::lock_guard lock(metrics_mutex_);
@@ -232,7 +241,7 @@ void PipelineRunner::processing_loop() {
       if (to_process_->size() > 0) waiting = std::move(*ctx);
       else run_from(*ctx, 1);
     } else if (first_runs_ahead() && to_process_->size() > 0) {
-      stages_[0]->process(*ctx);
+      run_ahead(*ctx);
       waiting = std::move(*ctx);
     } else {
       run_from(*ctx, 0);

@@ -53,6 +53,11 @@ class Stage {
   // that as the first stage it may process frame n + 1 on another thread while the later stages
   // process frame n (pipeline.overlap_first_stage).
   virtual bool can_run_ahead() const noexcept { return false; }
+  // Work on a frame that reads only that frame and what configure() set, never what this stage
+  // does to earlier frames (converting the camera picture): the runner does it on the helper thread
+  // that runs the first stage ahead, while this stage may be processing the frame before. Only then;
+  // process() must do whatever it finds not done. Must not throw.
+  virtual void process_ahead(FrameContext& ctx) noexcept { (void)ctx; }
   virtual void look_ahead(const FrameContext& next) noexcept { (void)next; }
 };
 

@@ -487,6 +487,8 @@ void TagTracker::Impl::track(FrameContext& ctx) {
              searched ? ", found near the prediction" : "");
 }
 
+bool TagTracker::can_run_ahead() const noexcept { return !impl_->nothing_virtual; }
+
 void TagTracker::process(FrameContext& ctx) noexcept {
   const auto start = std::chrono::steady_clock::now();
   std::string skipped;

@@ -16,8 +16,9 @@ class TagTracker : public Stage {
   void configure(const Config& config) override;
   // Fills ctx.pose from ctx.camera and ctx.camera_model. Lost tracking is a state, never an error.
   void process(FrameContext& ctx) noexcept override;
-  // It needs only the frame, the camera model it carries and its own pose history.
-  bool can_run_ahead() const noexcept override { return true; }
+  // It needs only the frame, the camera model it carries and its own pose history. Not with nothing
+  // virtual to draw: then it tracks nothing, and running ahead would only hand the frame over.
+  bool can_run_ahead() const noexcept override;
 
  private:
   struct Impl;
