@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <deque>
 #include <exception>
@@ -199,9 +200,11 @@ void PipelineRunner::processing_loop() {
       finish_frame(ctx, split);
     }
   };
-  // A frame's first stage, and what the later stages do ahead (Stage::process_ahead).
-  const auto run_ahead = [&](FrameContext& ctx) {
-    stages_[0]->process(ctx);
+  // What the later stages do ahead on a frame (Stage::process_ahead), once, by whichever thread
+  // comes to it first: the helper after the frame's first stage, or this thread after the frame
+  // before (a still frame's tracking is quick, its drawing quicker: either may finish first).
+  const auto later_stages_ahead = [&](FrameContext& ctx, std::atomic<bool>& taken) {
+    if (taken.exchange(true)) return;
     for (size_t i = 1; i < stages_.size(); ++i) stages_[i]->process_ahead(ctx);
   };
   // Whether the first stage may run on its own, ahead of the others (see below).
@@ -230,8 +233,13 @@ void PipelineRunner::processing_loop() {
     if (waiting) {
       FrameContext& next = *ctx;
       if (!helper) helper.emplace();
-      helper->start([&] { run_ahead(next); });
+      std::atomic<bool> ahead_taken{false};
+      helper->start([&] {
+        stages_[0]->process(next);
+        later_stages_ahead(next, ahead_taken);
+      });
       run_from(*waiting, 1);
+      later_stages_ahead(next, ahead_taken);
       helper->wait();
       waiting.reset();
       {
@@ -241,7 +249,7 @@ void PipelineRunner::processing_loop() {
       if (to_process_->size() > 0) waiting = std::move(*ctx);
       else run_from(*ctx, 1);
     } else if (first_runs_ahead() && to_process_->size() > 0) {
-      run_ahead(*ctx);
+      stages_[0]->process(*ctx);
       waiting = std::move(*ctx);
     } else {
       run_from(*ctx, 0);

@@ -53,10 +53,12 @@ class Stage {
   // that as the first stage it may process frame n + 1 on another thread while the later stages
   // process frame n (pipeline.overlap_first_stage).
   virtual bool can_run_ahead() const noexcept { return false; }
-  // Work on a frame that reads only that frame and what configure() set, never what this stage
-  // does to earlier frames (converting the camera picture): the runner does it on the helper thread
-  // that runs the first stage ahead, while this stage may be processing the frame before. Only then;
-  // process() must do whatever it finds not done. Must not throw.
+  // Work on a frame that reads only its camera image and what configure() set, never what this
+  // stage does to earlier frames, and writes only its own fields of the frame (converting the camera
+  // picture): when the first stage runs ahead, the runner has it done by whichever thread is free
+  // first, the helper after the first stage or the processing thread after the frame before, so it
+  // may run beside this stage's process() of the frame before and the first stage's of this one.
+  // Only then; process() must do whatever it finds not done. Must not throw.
   virtual void process_ahead(FrameContext& ctx) noexcept { (void)ctx; }
   virtual void look_ahead(const FrameContext& next) noexcept { (void)next; }
 };
