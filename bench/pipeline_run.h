@@ -13,6 +13,10 @@ namespace arpipe {
 // The first frames of a run pay for its setup (the EGL context, the lens map, the first render
 // targets, the threads' start): once per run, not per frame, so they are left out.
 constexpr int64_t kWarmupFrames = 10;
+// Pass-through runs this many times the frames of the runs it is compared with: it is ten times as
+// fast or more, and 300 of its frames last a tenth of a second, which one stall of the machine
+// could halve (seen: 1310 against 2952 frames/s in runs a minute apart).
+constexpr int64_t kPassThroughFramesFactor = 10;
 
 // Runs the config's source through every stage (no sinks) for kWarmupFrames frames more than its
 // pipeline.max_frames, and returns the metrics of the frames after those: frames_out, the stages'

@@ -61,7 +61,7 @@ Point measure(const fs::path& capture, int width, int height, int objects, int64
   const std::string grid = cube_grid(objects);
   run_pipeline(scaling_config(capture, 20, grid));  // warm-up: shader JIT, PRT cache
   const PipelineMetrics drawn = run_pipeline(scaling_config(capture, frames, grid));
-  const PipelineMetrics pass = run_pipeline(scaling_config(capture, frames, "render.objects=[]"));
+  const PipelineMetrics pass = run_pipeline(scaling_config(capture, kPassThroughFramesFactor * frames, "render.objects=[]"));
   return {width,        height, objects, drawn.fps(), pass.fps(), mean_stage_ms(drawn, "track"),
           mean_stage_ms(drawn, "render"), mean_stage_ms(drawn, "composite")};
 }

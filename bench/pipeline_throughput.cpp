@@ -91,7 +91,8 @@ int run_pipeline_benchmark(const PipelineOptions& options) {
   // cost is per pixel of the canvas rather than per pixel drawn.
   const PipelineMetrics cheap = run_pipeline(bench_config(
       options, options.frames, {"render.shadows.method=\"off\"", "render.msaa_samples=1", "render.lens=\"vertex\""}));
-  const PipelineMetrics pass = run_pipeline(bench_config(options, options.frames, {"render.objects=[]"}));
+  const PipelineMetrics pass =
+      run_pipeline(bench_config(options, kPassThroughFramesFactor * options.frames, {"render.objects=[]"}));
   print_row("the config", full);
   print_row("shadows off, MSAA off, render.lens = vertex", cheap);
   print_row("pass-through (no virtual object)", pass);
