@@ -1,7 +1,7 @@
 // One thread that runs one job at a time for another: the processing thread's helper that runs the
 // next frame's first stage ahead (pipeline.overlap_first_stage). Started once, so each frame pays
-// a hand-over between two waiting threads, not a thread's creation (a std::async per frame cost
-// the pass-through replay 7 % of its frames/s).
+// a hand-over between two waiting threads, not a thread's creation (with a std::async per frame
+// the default capture ran at 291-315 frames/s, with this at 328-335, alternating at 4a047cc).
 #pragma once
 
 #include <condition_variable>
