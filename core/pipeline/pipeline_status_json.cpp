@@ -36,6 +36,7 @@ nlohmann::json pipeline_status_json(const PipelineStatus& status) {
                    {"frames_still", m.frames_still},
                    {"frames_predicted", m.frames_predicted},
                    {"frames_lost", m.frames_lost},
+                   {"frames_overlapped", m.frames_overlapped},
                    {"latency_ms_mean", m.latency_seconds.count()
                                            ? json(m.latency_seconds.sum() / double(m.latency_seconds.count()) * 1e3)
                                            : json(nullptr)},

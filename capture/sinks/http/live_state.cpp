@@ -45,6 +45,9 @@ std::string live_metrics_text(const PipelineStatus& status, bool camera_away, co
   w.sample("arpipe_frames_by_track_state_total", {{"state", "tracking"}}, double(m.frames_tracked));
   w.sample("arpipe_frames_by_track_state_total", {{"state", "predicted"}}, double(m.frames_predicted));
   w.sample("arpipe_frames_by_track_state_total", {{"state", "lost"}}, double(m.frames_lost));
+  w.family("arpipe_frames_overlapped_total", "counter",
+           "Frames whose tracking ran on the helper thread while the frame before rendered (pipeline.overlap_first_stage).");
+  w.sample("arpipe_frames_overlapped_total", double(m.frames_overlapped));
   w.family("arpipe_stage_runs_total", "counter", "Frames each stage was given, skips included.");
   for (const auto& [name, stats] : m.stages) w.sample("arpipe_stage_runs_total", {{"stage", name}}, double(stats.runs));
   w.family("arpipe_stage_skips_total", "counter", "Frames a stage returned at once for, by reason.");

@@ -58,6 +58,7 @@ struct Served {
       status.source_connected = camera_connected;
       status.sinks.push_back({"sinks.http", 3, 1, 0});
       status.metrics.frames_in = 3;
+      status.metrics.frames_overlapped = 2;
       status.metrics.stages["render"].runs = 3;
       status.metrics.stages["render"].seconds.add(0.004);
       status.metrics.stages["render"].skips["reused: pose, light and objects unchanged"] = 1;
@@ -393,6 +394,7 @@ TEST(HttpSink, PromtoolAcceptsTheMetrics) {
   EXPECT_NE(metrics->body.find("arpipe_stage_duration_seconds_bucket{stage=\"render\",le=\"+Inf\"} 1\n"), std::string::npos);
   EXPECT_NE(metrics->body.find("arpipe_sink_dropped_frames_total{sink=\"sinks.http\"} 1\n"), std::string::npos);
   EXPECT_NE(metrics->body.find("arpipe_http_frames_not_encoded_total 1\n"), std::string::npos);
+  EXPECT_NE(metrics->body.find("arpipe_frames_overlapped_total 2\n"), std::string::npos);
   if (std::system("command -v promtool >/dev/null 2>&1") != 0) GTEST_SKIP() << "promtool is not installed";
   const std::filesystem::path file = std::filesystem::temp_directory_path() / ("arpipe-metrics-" + std::to_string(::getpid()));
   std::ofstream(file) << metrics->body;
