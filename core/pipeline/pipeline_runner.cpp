@@ -154,10 +154,11 @@ void PipelineRunner::capture_loop() {
 
 size_t PipelineRunner::frames_in_flight_bound(size_t sink_count) const {
   const auto depth = size_t(config_.pipeline.queue_depth);
-  // One in each of the capture, processing and sink threads and the stereo packer; the two queues
-  // between them; the sinks' queues hold the newest frames (shared), each sink one it is consuming
-  // and one it may keep (a preview's latest frame).
-  return 4 + 2 * depth + held_frames_bound_ + size_t(config_.pipeline.sink_queue_depth) + 2 * sink_count;
+  // One in each of the capture and sink threads and the stereo packer, two in the processing
+  // thread (with the overlap, the frame waiting for the next one and the next one, tracked on the
+  // helper); the two queues between them; the sinks' queues hold the newest frames (shared), each
+  // sink one it is consuming and one it may keep (a preview's latest frame).
+  return 5 + 2 * depth + held_frames_bound_ + size_t(config_.pipeline.sink_queue_depth) + 2 * sink_count;
 }
 
 size_t PipelineRunner::first_stage_with_latency() const {
