@@ -32,7 +32,7 @@
 #include "capture/raw_colour_source.h"
 #include "capture/recording/recording_copy.h"
 #include "core/image/pixel_convert.h"
-#include "core/frame_memory.h"
+#include "core/system/frame_memory.h"
 #include "core/log.h"
 #include "core/pipeline/bounded_queue.h"
 #include "core/pipeline/frame_pool.h"

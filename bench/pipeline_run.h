@@ -3,7 +3,9 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <string>
+#include <string_view>
 
 #include "core/config/config.h"
 #include "core/pipeline/pipeline_metrics.h"
@@ -18,12 +20,28 @@ constexpr int64_t kWarmupFrames = 10;
 // could halve (seen: 1310 against 2952 frames/s in runs a minute apart).
 constexpr int64_t kPassThroughFramesFactor = 10;
 
+// Where a run's CPU went per frame, by group of threads (the processing thread, its helper, the GL
+// rasteriser's threads, capture and sinks, the rest), and how many cores were busy on average.
+// Measured from the last warm-up frame to kCpuTailFrames before the last frame: the GL
+// rasteriser's threads end with the run, and by then every thread is still running (the
+// processing thread is at most the queues' depth ahead of the frames handed over).
+struct CpuPerFrame {
+  int64_t frames = 0;  // 0: not measured (a run of kCpuTailFrames frames or fewer, or no /proc)
+  std::map<std::string, double> ms_by_group;
+  double total_ms = 0;
+  double cores_busy = 0;  // CPU seconds over wall seconds
+};
+constexpr int64_t kCpuTailFrames = 64;
+// The group a thread's name puts it in (see CpuPerFrame).
+std::string cpu_group_of(std::string_view thread_name);
+
 // Runs the config's source through every stage (no sinks) for kWarmupFrames frames more than its
 // pipeline.max_frames, and returns the metrics of the frames after those: frames_out, the stages'
 // times and skips, the tracking counts, and wall_seconds from the last warm-up frame's hand-over
 // to the last frame's. setup_seconds, when given, receives the time from building the pipeline to
 // the first frame's hand-over: what a start costs before the first picture.
-PipelineMetrics run_pipeline(Config config, double* setup_seconds = nullptr);
+// cpu, when given, receives the run's CpuPerFrame.
+PipelineMetrics run_pipeline(Config config, double* setup_seconds = nullptr, CpuPerFrame* cpu = nullptr);
 // Mean ms per frame of a stage, skipped frames included; 0 when it never ran.
 double mean_stage_ms(const PipelineMetrics& metrics, const std::string& stage);
 

@@ -19,7 +19,7 @@
 #include "apps/common/pipeline_assembly.h"
 #include "bench/benchmarks.h"
 #include "bench/pipeline_run.h"
-#include "core/frame_memory.h"
+#include "core/system/frame_memory.h"
 #include "core/log.h"
 
 namespace arpipe {
@@ -65,6 +65,39 @@ void print_row(const std::string& name, const PipelineMetrics& m) {
   fmt::print("| {} | {} | {:.1f} |{}\n", name, m.frames_out, m.fps(), cells);
 }
 
+struct CpuRow {
+  std::string name;
+  const PipelineMetrics& metrics;
+  const CpuPerFrame& cpu;
+};
+
+// Where each run's CPU went per frame, and what the runs' CPU allows with every core busy: a run
+// whose frames need C ms of CPU cannot pass N cores / C frames/s however its work is spread.
+void print_cpu_table(const std::vector<CpuRow>& rows) {
+  const std::vector<std::string> groups{"processing", "helper", "GL rasteriser", "capture and sinks", "other"};
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  fmt::print("\nCPU per frame by thread (ms; from the last warm-up frame to the {}th before the last):\n\n| run |",
+             kCpuTailFrames);
+  for (const std::string& group : groups) fmt::print(" {} |", group);
+  std::string rule = "|---|";
+  for (size_t i = 0; i < groups.size() + 3; ++i) rule += "---:|";
+  fmt::print(" all | cores busy | frames/s with all {} cores busy |\n{}\n", cores, rule);
+
+  for (const CpuRow& row : rows) {
+    if (row.cpu.frames == 0) {
+      fmt::print("| {} | not measured (a run of {} frames or fewer, or no /proc) |\n", row.name, kCpuTailFrames);
+      continue;
+    }
+    fmt::print("| {} |", row.name);
+    for (const std::string& group : groups) {
+      const auto it = row.cpu.ms_by_group.find(group);
+      fmt::print(" {:.2f} |", it == row.cpu.ms_by_group.end() ? 0.0 : it->second);
+    }
+    fmt::print(" {:.2f} | {:.2f} | {:.1f} |\n", row.cpu.total_ms, row.cpu.cores_busy,
+               row.cpu.total_ms > 0 ? 1e3 * cores / row.cpu.total_ms : 0.0);
+  }
+}
+
 int run_pipeline_benchmark(const PipelineOptions& options) {
   log::set_max_level(log::Level::Warning);
   utsname u{};
@@ -86,13 +119,15 @@ int run_pipeline_benchmark(const PipelineOptions& options) {
   // Warm-up (shader JIT, the PRT cache, the page cache), then the measured runs.
   run_pipeline(bench_config(options, 30));
   double setup_seconds = 0;
-  const PipelineMetrics full = run_pipeline(config, &setup_seconds);
+  CpuPerFrame full_cpu, cheap_cpu, pass_cpu;
+  const PipelineMetrics full = run_pipeline(config, &setup_seconds, &full_cpu);
   // What the issue of record compares against: the same objects without the three features whose
   // cost is per pixel of the canvas rather than per pixel drawn.
   const PipelineMetrics cheap = run_pipeline(bench_config(
-      options, options.frames, {"render.shadows.method=\"off\"", "render.msaa_samples=1", "render.lens=\"vertex\""}));
-  const PipelineMetrics pass =
-      run_pipeline(bench_config(options, kPassThroughFramesFactor * options.frames, {"render.objects=[]"}));
+      options, options.frames, {"render.shadows.method=\"off\"", "render.msaa_samples=1", "render.lens=\"vertex\""}),
+      nullptr, &cheap_cpu);
+  const PipelineMetrics pass = run_pipeline(
+      bench_config(options, kPassThroughFramesFactor * options.frames, {"render.objects=[]"}), nullptr, &pass_cpu);
   print_row("the config", full);
   print_row("shadows off, MSAA off, render.lens = vertex", cheap);
   print_row("pass-through (no virtual object)", pass);
@@ -102,6 +137,8 @@ int run_pipeline_benchmark(const PipelineOptions& options) {
              cheap_render > 0 ? fmt::format("{:.2f}", full_render / cheap_render) : std::string("-"));
   fmt::print("the config's start, from building the pipeline to its first frame: {:.0f} ms (not in the rows)\n",
              setup_seconds * 1e3);
+  print_cpu_table({{"the config", full, full_cpu}, {"shadows off, MSAA off, render.lens = vertex", cheap, cheap_cpu},
+                   {"pass-through (no virtual object)", pass, pass_cpu}});
 
   if (options.soak_seconds > 0) {
     const Config soak = bench_config(options, 0);

@@ -5,7 +5,7 @@
 
 #include "apps/arpipe/commands.h"
 #include "apps/cli/command_line.h"
-#include "core/frame_memory.h"
+#include "core/system/frame_memory.h"
 #include "core/log.h"
 
 int main(int argc, char** argv) {

@@ -1,7 +1,7 @@
 // arpiped: the arpipe daemon. Runs capture -> track -> render -> composite -> sinks from a config.
 #include "apps/arpiped/daemon.h"
 #include "apps/cli/command_line.h"
-#include "core/frame_memory.h"
+#include "core/system/frame_memory.h"
 
 int main(int argc, char** argv) {
   arpipe::keep_frame_memory_resident();

@@ -3,9 +3,15 @@
 
 #include <utility>
 
+#include "core/system/thread_cpu.h"
+
 namespace arpipe {
 
-HelperThread::HelperThread() : thread_([this] { loop(); }) {}
+HelperThread::HelperThread()
+    : thread_([this] {
+        name_this_thread("arp-helper");
+        loop();
+      }) {}
 
 HelperThread::~HelperThread() {
   {

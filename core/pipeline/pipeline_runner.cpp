@@ -12,6 +12,7 @@
 
 #include "core/log.h"
 #include "core/pipeline/helper_thread.h"
+#include "core/system/thread_cpu.h"
 #include "core/pipeline/monotonic_clock.h"
 
 namespace arpipe {
@@ -54,6 +55,7 @@ void PipelineRunner::start() {
   std::promise<void> configured;
   auto configured_future = configured.get_future();
   processing_thread_ = std::thread([this, &configured] {
+    name_this_thread("arp-process");
     try {
       stages_ = stage_factory_();
       std::vector<std::pair<std::string, StageAssetLoader>> loaders;
@@ -100,8 +102,14 @@ void PipelineRunner::start() {
     std::lock_guard lock(sinks_mutex_);
     sinks_ = std::move(workers);
   }
-  sink_thread_ = std::thread([this] { sink_loop(); });
-  capture_thread_ = std::thread([this] { capture_loop(); });
+  sink_thread_ = std::thread([this] {
+    name_this_thread("arp-sinks");
+    sink_loop();
+  });
+  capture_thread_ = std::thread([this] {
+    name_this_thread("arp-capture");
+    capture_loop();
+  });
 }
 
 void PipelineRunner::stop() {

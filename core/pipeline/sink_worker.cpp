@@ -1,6 +1,7 @@
 #include "core/pipeline/sink_worker.h"
 
 #include "core/pipeline/monotonic_clock.h"
+#include "core/system/thread_cpu.h"
 
 namespace arpipe {
 
@@ -10,7 +11,10 @@ SinkWorker::SinkWorker(std::string key, std::unique_ptr<FrameSink> sink, size_t 
 SinkWorker::~SinkWorker() { finish(); }
 
 void SinkWorker::start() {
-  thread_ = std::thread([this] { run(); });
+  thread_ = std::thread([this] {
+    name_this_thread("arp-sink " + key_);
+    run();
+  });
 }
 
 void SinkWorker::push(std::shared_ptr<const FrameContext> frame) { queue_.push(std::move(frame)); }

@@ -19,7 +19,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "capture/sinks/http/http_sink.h"
-#include "core/frame_memory.h"
+#include "core/system/frame_memory.h"
 #include "core/pipeline/monotonic_clock.h"
 #include "bench/http_client.h"
 

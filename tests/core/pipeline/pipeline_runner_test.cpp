@@ -10,12 +10,14 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <pthread.h>
 #include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "core/pipeline/pipeline_runner.h"
+#include "core/system/thread_cpu.h"
 
 namespace arpipe {
 namespace {
@@ -246,6 +248,8 @@ struct SinkLog : SharedLog {
   int pixel_mismatches = 0;
   int flushes = 0;
   int frames_after_flush = 0;
+  std::vector<std::string> threads_at_first_frame;  // the process's thread names (top -H, /proc)
+  std::string own_thread_name;                     // the thread consume() ran on
 };
 
 class FakeSink : public FrameSink {
@@ -268,6 +272,12 @@ class FakeSink : public FrameSink {
         break;
       }
     if (log_->flushes > 0) ++log_->frames_after_flush;
+    if (log_->threads_at_first_frame.empty()) {
+      for (const ThreadCpu& thread : threads_cpu()) log_->threads_at_first_frame.push_back(thread.name);
+      char name[16] = {};
+      pthread_getname_np(pthread_self(), name, sizeof name);
+      log_->own_thread_name = name;
+    }
     log_->changed.notify_all();
   }
 
@@ -412,6 +422,23 @@ TEST(PipelineRunner, ReplayDeliversEveryFrameToEverySinkOnceAndInOrder) {
   EXPECT_EQ(m.stages.at("second").runs, kFrames);
   EXPECT_EQ(m.stages.at("second").total_ms, 1.5 * kFrames);
   EXPECT_TRUE(m.stages.at("second").skips.empty());
+}
+
+// Each of the pipeline's threads carries its part's name, so that top -H and the pipeline
+// benchmark's CPU table (bench/pipeline_run.h) tell them apart.
+TEST(PipelineRunner, ItsThreadsAreNamedForTheirParts) {
+  // A slow sink and queues one deep: every thread is still at work (or blocked) at the first frame.
+  Harness h(Setup::replaying(frames_0_to(30))
+                .with_sink_delays({std::chrono::milliseconds(5)})
+                .with_config(config_marked("run", 1)));
+  h.runner->start();
+  h.runner->wait();
+  const SinkLog& log = *h.sink_logs.at(0);
+  for (const char* name : {"arp-capture", "arp-process", "arp-sinks"})
+    EXPECT_NE(std::find(log.threads_at_first_frame.begin(), log.threads_at_first_frame.end(), name),
+              log.threads_at_first_frame.end())
+        << name;
+  EXPECT_TRUE(log.own_thread_name.starts_with("arp-sink ")) << log.own_thread_name;
 }
 
 TEST(PipelineRunner, StageThatHoldsFramesBackSeesTheNextFrameFirstAndNothingIsLost) {

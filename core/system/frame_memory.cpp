@@ -1,4 +1,4 @@
-#include "core/frame_memory.h"
+#include "core/system/frame_memory.h"
 
 #include <malloc.h>
 

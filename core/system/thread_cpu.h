@@ -1,0 +1,36 @@
+// Names this process's threads and reads each one's CPU time, so that a benchmark can say where a
+// frame's CPU goes (which thread, how many cores busy) and `top -H` shows the pipeline's parts.
+#pragma once
+
+#include <map>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace arpipe {
+
+// The calling thread's name as /proc and top show it (Linux keeps 15 bytes; the rest is cut).
+void name_this_thread(std::string_view name);
+
+struct ThreadCpu {
+  int tid = 0;
+  std::string name;            // /proc/self/task/TID/comm
+  double cpu_seconds = 0;      // on a CPU since the thread started (user and kernel)
+};
+
+// utime + stime of a /proc stat line, in seconds (ticks of sysconf(_SC_CLK_TCK)); 0 for a line
+// that does not parse. The name field may hold spaces and parentheses.
+double cpu_seconds_from_stat_line(std::string_view stat);
+
+// Every live thread of this process. From /proc/self/task/TID/schedstat (nanoseconds), else the
+// stat file's utime + stime (clock ticks, 10 ms); empty when /proc does not say.
+std::vector<ThreadCpu> threads_cpu();
+
+// CPU seconds per thread between two snapshots, by tid (a thread started between them counts from
+// zero; one that ended between them is missing, its time lost). Summed by the group that
+// `group_of` gives each thread's name.
+std::map<std::string, double> cpu_seconds_between(const std::vector<ThreadCpu>& before,
+                                                  const std::vector<ThreadCpu>& after,
+                                                  std::string (*group_of)(std::string_view name));
+
+}  // namespace arpipe
