@@ -81,6 +81,7 @@ nlohmann::json ResultsSink::to_json(const FrameContext& ctx) {
                   {"source", ctx.light.source},
                   {"confidence", ctx.light.confidence}};
     if (ctx.light.frames_since_measured > 0) light["frames_since_measured"] = ctx.light.frames_since_measured;
+    if (ctx.light.frames_kept > 0) light["frames_kept"] = ctx.light.frames_kept;
     if (!ctx.light.note.empty()) light["note"] = ctx.light.note;
     json lights = json::array();
     for (const DirectionalLight& l : ctx.light.lights) {

@@ -568,6 +568,11 @@ struct ProbeConfig {
   // 0: the lights are infinitely far; > 0: the strongest is a lamp this far from the probe's
   // centre (measured by hand: a probe sees directions only).
   double light_distance_m = 0;
+  // A measurement within this of the last one handed on keeps that one (core/light/light_hold.h):
+  // each light's direction seen from the probe (degrees), and the relative change of each light's
+  // irradiance and of the ambient light. Both 0: every frame's measurement as it is.
+  double hold_direction_deg = 0.5;
+  double hold_change = 0.05;
 
   bool operator==(const ProbeConfig&) const = default;
 };
@@ -586,6 +591,10 @@ void visit(V& v, ProbeConfig& s) {
   v.key("max_lights", s.max_lights, IntRange{1, 4}, "dominant lights kept");
   v.key("light_distance_m", s.light_distance_m, NumberRange::closed(0, 1e6).in("m; 0: infinitely far"),
         "0: lights infinitely far; > 0: the key lamp's distance from the probe");
+  v.key("hold_direction_deg", s.hold_direction_deg, NumberRange::closed(0, 10).in("degrees"),
+        "a measurement whose lights turned less than this (and changed less than hold_change) keeps the last light");
+  v.key("hold_change", s.hold_change, NumberRange::closed(0, 1),
+        "relative change of the lights' irradiance and the ambient light under which the last light is kept");
 }
 
 // The sun from place and time (core/light): NREL's SPA, turned into the anchor frame.

@@ -45,6 +45,9 @@ struct LightEstimate {
   bool scene_linear = false;             // units as above (false: nothing estimated yet)
   double confidence = 0;                 // [0, 1]: how far the estimate can be trusted
   int frames_since_measured = 0;         // Held: frames since the last measurement
+  // Estimated: frames since this estimate was measured, each frame's own measurement having been
+  // within light.probe.hold_* of it (core/light/light_hold.h); 0: measured on this frame.
+  int frames_kept = 0;
   std::string note;                      // why Held / NoDirect / low confidence, for the results
 };
 

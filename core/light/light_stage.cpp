@@ -184,6 +184,7 @@ void LightStage::configure_loaded(const Config& config, const std::shared_ptr<co
   ground_albedo_ = light.ground_albedo;
   response_ = response;
   probe_light_distance_m_ = light.probe.light_distance_m;
+  hold_ = LightHold({light.probe.hold_direction_deg * std::numbers::pi / 180, light.probe.hold_change}, light.probe.center_m);
   last_note_.clear();
 }
 
@@ -243,6 +244,7 @@ void LightStage::process(FrameContext& ctx) noexcept {
       key.position_world = probe_centre_ + probe_light_distance_m_ * key.direction_world;
       key.direction_world = normalized(key.position_world);
     }
+    ctx.light = hold_.apply(ctx.light);
   } else {
     ctx.light = sun_->update(ctx.camera, *ctx.camera_model, ctx.pose.T_cam_world, pose_valid, realtime_minus_monotonic_ns());
   }

@@ -13,6 +13,7 @@
 
 #include "core/config/light_source.h"
 #include "core/light/ground_radiance.h"
+#include "core/light/light_hold.h"
 #include "core/probe/probe_light_estimator.h"
 #include "core/scene/gltf_animation.h"
 #include "core/sh/sh_window.h"
@@ -58,6 +59,7 @@ class LightStage final : public Stage {
   } panorama_;                   // Panorama: with the SH each frame brings
   void pose_scene_lights(FrameContext& ctx) noexcept;
   Vec3 probe_centre_{0, 0, 0};
+  LightHold hold_;  // the probe's measurements within their noise of the last light keep it
   Vec3 ground_albedo_{0.3, 0.3, 0.3};
   CameraResponse response_;
   GroundRadiance ground_;
