@@ -31,9 +31,9 @@ class SteadyStateSink final : public FrameSink {
     ++m.frames_out;
     if (int64_t(m.frames_out) == cpu_until_ && !cpu_before_.empty()) {
       cpu_.frames = cpu_until_;
-      cpu_.ms_by_group = cpu_seconds_between(cpu_before_, threads_cpu(), [](std::string_view name) { return cpu_group_of(name); });
+      cpu_.ms_by_part = cpu_seconds_between(cpu_before_, threads_cpu(), thread_part);
       const double wall = std::chrono::duration<double>(now - since_).count();
-      for (auto& [group, seconds] : cpu_.ms_by_group) {
+      for (auto& [part, seconds] : cpu_.ms_by_part) {
         cpu_.total_ms += seconds * 1e3 / double(cpu_until_);
         cpu_.cores_busy += wall > 0 ? seconds / wall : 0;
         seconds *= 1e3 / double(cpu_until_);
@@ -57,14 +57,6 @@ class SteadyStateSink final : public FrameSink {
 };
 
 }  // namespace
-
-std::string cpu_group_of(std::string_view thread_name) {
-  if (thread_name == "arp-process") return "processing";
-  if (thread_name == "arp-helper") return "helper";
-  if (thread_name.starts_with("llvmpipe")) return "GL rasteriser";
-  if (thread_name == "arp-capture" || thread_name.starts_with("arp-sink")) return "capture and sinks";
-  return "other";
-}
 
 PipelineMetrics run_pipeline(Config config, double* setup_seconds, CpuPerFrame* cpu) {
   const int64_t measured_frames = config.pipeline.max_frames;

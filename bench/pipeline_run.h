@@ -5,7 +5,6 @@
 #include <cstdint>
 #include <map>
 #include <string>
-#include <string_view>
 
 #include "core/config/config.h"
 #include "core/pipeline/pipeline_metrics.h"
@@ -20,20 +19,19 @@ constexpr int64_t kWarmupFrames = 10;
 // could halve (seen: 1310 against 2952 frames/s in runs a minute apart).
 constexpr int64_t kPassThroughFramesFactor = 10;
 
-// Where a run's CPU went per frame, by group of threads (the processing thread, its helper, the GL
-// rasteriser's threads, capture and sinks, the rest), and how many cores were busy on average.
+// Where a run's CPU went per frame, by part of the pipeline (thread_part, core/system/thread_cpu.h:
+// the processing thread, its helper, the GL rasteriser's threads, capture, sinks, the rest), and
+// how many cores were busy on average.
 // Measured from the last warm-up frame to kCpuTailFrames before the last frame: the GL
 // rasteriser's threads end with the run, and by then every thread is still running (the
 // processing thread is at most the queues' depth ahead of the frames handed over).
 struct CpuPerFrame {
   int64_t frames = 0;  // 0: not measured (a run of kCpuTailFrames frames or fewer, or no /proc)
-  std::map<std::string, double> ms_by_group;
+  std::map<std::string, double> ms_by_part;
   double total_ms = 0;
   double cores_busy = 0;  // CPU seconds over wall seconds
 };
 constexpr int64_t kCpuTailFrames = 64;
-// The group a thread's name puts it in (see CpuPerFrame).
-std::string cpu_group_of(std::string_view thread_name);
 
 // Runs the config's source through every stage (no sinks) for kWarmupFrames frames more than its
 // pipeline.max_frames, and returns the metrics of the frames after those: frames_out, the stages'

@@ -74,13 +74,15 @@ struct CpuRow {
 // Where each run's CPU went per frame, and what the runs' CPU allows with every core busy: a run
 // whose frames need C ms of CPU cannot pass N cores / C frames/s however its work is spread.
 void print_cpu_table(const std::vector<CpuRow>& rows) {
-  const std::vector<std::string> groups{"processing", "helper", "GL rasteriser", "capture and sinks", "other"};
+  const std::vector<std::pair<std::string, std::string>> parts{
+      {"processing", "processing"}, {"helper", "helper"}, {"gl", "GL rasteriser"}, {"capture", "capture"},
+      {"sinks", "sinks"}, {"other", "other"}};
   const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
   fmt::print("\nCPU per frame by thread (ms; from the last warm-up frame to the {}th before the last):\n\n| run |",
              kCpuTailFrames);
-  for (const std::string& group : groups) fmt::print(" {} |", group);
+  for (const auto& [part, title] : parts) fmt::print(" {} |", title);
   std::string rule = "|---|";
-  for (size_t i = 0; i < groups.size() + 3; ++i) rule += "---:|";
+  for (size_t i = 0; i < parts.size() + 3; ++i) rule += "---:|";
   fmt::print(" all | cores busy | frames/s with all {} cores busy |\n{}\n", cores, rule);
 
   for (const CpuRow& row : rows) {
@@ -89,9 +91,9 @@ void print_cpu_table(const std::vector<CpuRow>& rows) {
       continue;
     }
     fmt::print("| {} |", row.name);
-    for (const std::string& group : groups) {
-      const auto it = row.cpu.ms_by_group.find(group);
-      fmt::print(" {:.2f} |", it == row.cpu.ms_by_group.end() ? 0.0 : it->second);
+    for (const auto& [part, title] : parts) {
+      const auto it = row.cpu.ms_by_part.find(part);
+      fmt::print(" {:.2f} |", it == row.cpu.ms_by_part.end() ? 0.0 : it->second);
     }
     fmt::print(" {:.2f} | {:.2f} | {:.1f} |\n", row.cpu.total_ms, row.cpu.cores_busy,
                row.cpu.total_ms > 0 ? 1e3 * cores / row.cpu.total_ms : 0.0);

@@ -2,6 +2,7 @@
 
 #include <dirent.h>
 #include <pthread.h>
+#include <sys/resource.h>
 
 #include <charconv>
 #include <fstream>
@@ -66,6 +67,37 @@ std::vector<ThreadCpu> threads_cpu() {
   }
   closedir(tasks);
   return out;
+}
+
+double process_cpu_seconds() {
+  rusage usage{};
+  if (getrusage(RUSAGE_SELF, &usage) != 0) return 0;
+  const auto seconds = [](const timeval& t) { return double(t.tv_sec) + double(t.tv_usec) * 1e-6; };
+  return seconds(usage.ru_utime) + seconds(usage.ru_stime);
+}
+
+std::string thread_part(std::string_view name) {
+  if (name == "arp-process") return "processing";
+  if (name == "arp-helper") return "helper";
+  if (name.starts_with("llvmpipe")) return "gl";
+  if (name == "arp-capture") return "capture";
+  if (name == "arp-sinks" || name.starts_with("arp-sink ")) return "sinks";
+  return "other";
+}
+
+std::map<std::string, double> CpuByPart::update() {
+  const std::vector<ThreadCpu> now = threads_cpu();
+  std::lock_guard lock(mutex_);
+  std::map<int, double> seen;
+  for (const ThreadCpu& thread : now) {
+    const auto it = last_by_tid_.find(thread.tid);
+    // A tid used again by a thread started since has a smaller counter: it counts whole.
+    const double before = it != last_by_tid_.end() && it->second <= thread.cpu_seconds ? it->second : 0.0;
+    totals_[thread_part(thread.name)] += thread.cpu_seconds - before;
+    seen[thread.tid] = thread.cpu_seconds;
+  }
+  last_by_tid_ = std::move(seen);
+  return totals_;
 }
 
 std::map<std::string, double> cpu_seconds_between(const std::vector<ThreadCpu>& before,

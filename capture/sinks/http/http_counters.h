@@ -2,6 +2,8 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
+#include <string>
 
 #include "core/pipeline/latency_histogram.h"
 
@@ -17,6 +19,10 @@ struct HttpCounters {
   double recent_fps = 0;           // frames published per second over the last ones
   // From the end of exposure to the frame's last byte handed to a stream client's socket.
   LatencyHistogram stream_latency_seconds;
+  // The daemon's CPU by part of the pipeline (core/system/thread_cpu.h CpuByPart), and the whole
+  // process's (every thread, ended ones too); filled for /metrics.
+  std::map<std::string, double> cpu_seconds_by_part;
+  double process_cpu_seconds = 0;
 };
 
 }  // namespace arpipe

@@ -180,7 +180,10 @@ HttpReply HttpSink::get(std::string_view path) noexcept {
       HttpReply reply;
       if (path == "/metrics") {
         reply.content_type = "text/plain; version=0.0.4; charset=utf-8";
-        reply.body = live_metrics_text(status, away, counters());
+        HttpCounters c = counters();
+        c.cpu_seconds_by_part = cpu_by_part_.update();
+        c.process_cpu_seconds = process_cpu_seconds();
+        reply.body = live_metrics_text(status, away, c);
       } else {
         const std::shared_ptr<const FrameContext> latest = board_.latest_frame();
         const double age = latest ? double(monotonic_now_ns() - board_.latest_published_ns()) * 1e-9 : 0;

@@ -16,6 +16,7 @@
 #include "core/config/config.h"
 #include "core/pipeline/frame_sink.h"
 #include "core/pipeline/pipeline_status.h"
+#include "core/system/thread_cpu.h"
 
 namespace arpipe {
 
@@ -47,6 +48,7 @@ class HttpSink : public FrameSink, private HttpHandler {
   mutable std::mutex counters_mutex_;
   HttpCounters counters_;
   std::deque<int64_t> recent_published_ns_;  // for recent_fps
+  CpuByPart cpu_by_part_;  // /metrics' CPU counters, carried from one scrape to the next
   std::mutex placeholder_mutex_;
   std::shared_ptr<const LiveJpeg> placeholder_;
   int placeholder_width_ = 0, placeholder_height_ = 0;

@@ -92,6 +92,12 @@ std::string live_metrics_text(const PipelineStatus& status, bool camera_away, co
   w.family("arpipe_http_stream_latency_seconds", "histogram",
            "From the end of the exposure (a replay: the frame's arrival) to the frame's last byte handed to a stream client's socket.");
   w.histogram("arpipe_http_stream_latency_seconds", {}, http.stream_latency_seconds);
+  w.family("process_cpu_seconds_total", "counter", "User and system CPU time of the whole process, every thread's.");
+  w.sample("process_cpu_seconds_total", http.process_cpu_seconds);
+  w.family("arpipe_cpu_seconds_total", "counter",
+           "CPU time by part of the pipeline: processing (the stages), helper (tracking ahead), gl (llvmpipe's "
+           "rasteriser), capture, sinks, other; a thread that ended loses its time since the scrape before.");
+  for (const auto& [part, seconds] : http.cpu_seconds_by_part) w.sample("arpipe_cpu_seconds_total", {{"part", part}}, seconds);
   return w.text();
 }
 

@@ -383,6 +383,52 @@ TEST(HttpSink, ANewSinkOnTheSameAddressTakesTheSocketOver) {
   EXPECT_EQ(snapshot->headers["x-arpipe-sequence"], "501");  // the new sink's frame
 }
 
+// The value of the sample whose line starts with `name_and_labels` (then a space); NaN when absent.
+double sample_value(const std::string& metrics, const std::string& name_and_labels) {
+  const std::string start = name_and_labels + " ";
+  for (size_t at = 0; at < metrics.size();) {
+    const size_t end = metrics.find('\n', at);
+    const std::string line = metrics.substr(at, end == std::string::npos ? std::string::npos : end - at);
+    if (line.starts_with(start)) return std::stod(line.substr(start.size()));
+    if (end == std::string::npos) break;
+    at = end + 1;
+  }
+  return std::nan("");
+}
+
+// /metrics counts the process's CPU, whole and by part of the pipeline: 50 ms this (unnamed, so
+// "other") thread spends between two scrapes shows in both, and the parts never add to more
+// than the whole.
+TEST(HttpSink, TheMetricsCountTheProcessCpuByPart) {
+  Served s;
+  const auto scrape = [&] {
+    auto metrics = http_request(s.address, "/metrics");
+    EXPECT_TRUE(metrics);
+    return metrics ? metrics->body : std::string();
+  };
+  const std::string before = scrape();
+  timespec start{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &start);
+  for (volatile double sink = 0;;) {
+    sink = sink + 1.0;
+    timespec now{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
+    if (double(now.tv_sec - start.tv_sec) + double(now.tv_nsec - start.tv_nsec) * 1e-9 >= 0.05) break;
+  }
+  const std::string after = scrape();
+  const double other = sample_value(after, "arpipe_cpu_seconds_total{part=\"other\"}") -
+                       sample_value(before, "arpipe_cpu_seconds_total{part=\"other\"}");
+  const double whole = sample_value(after, "process_cpu_seconds_total") - sample_value(before, "process_cpu_seconds_total");
+  EXPECT_GE(other, 0.05 - 1e-3);
+  EXPECT_GE(whole, 0.05 - 0.011);  // getrusage counts in the kernel's ticks on some kernels
+  double parts = 0;
+  for (const char* part : {"processing", "helper", "gl", "capture", "sinks", "other"}) {
+    const double v = sample_value(after, std::string("arpipe_cpu_seconds_total{part=\"") + part + "\"}");
+    if (!std::isnan(v)) parts += v;
+  }
+  EXPECT_LE(parts, sample_value(after, "process_cpu_seconds_total") + 0.011);
+}
+
 // promtool (Debian's prometheus package) is the reference for the text format; skipped without it.
 TEST(HttpSink, PromtoolAcceptsTheMetrics) {
   Served s;

@@ -18,6 +18,14 @@ double own_cpu_seconds() {
   return double(t.tv_sec) + double(t.tv_nsec) * 1e-9;
 }
 
+// Spins until this thread has spent `seconds` of CPU; returns its CPU clock then.
+double burn(double seconds) {
+  const double start = own_cpu_seconds();
+  volatile double sink = 0;
+  while (own_cpu_seconds() - start < seconds) sink = sink + 1.0;
+  return own_cpu_seconds();
+}
+
 const ThreadCpu* find_named(const std::vector<ThreadCpu>& threads, std::string_view name) {
   const auto it = std::find_if(threads.begin(), threads.end(), [&](const ThreadCpu& t) { return t.name == name; });
   return it == threads.end() ? nullptr : &*it;
@@ -30,10 +38,7 @@ TEST(ThreadCpu, ANamedThreadIsListedWithTheCpuTimeItsOwnClockGives) {
   double burnt = 0;
   std::thread burner([&] {
     name_this_thread("arp-test-burner, a name longer than fifteen bytes");
-    const double start = own_cpu_seconds();
-    volatile double sink = 0;
-    while (own_cpu_seconds() - start < 0.06) sink = sink + 1.0;
-    burnt = own_cpu_seconds();
+    burnt = burn(0.06);
     stage = 1;
     stage.notify_all();
     stage.wait(1);  // blocked, not spinning: no CPU until it is told to end
@@ -53,6 +58,51 @@ TEST(ThreadCpu, ANamedThreadIsListedWithTheCpuTimeItsOwnClockGives) {
   const double step = nanoseconds ? 1e-6 : 1.0 / double(sysconf(_SC_CLK_TCK));
   EXPECT_GE(found->cpu_seconds, burnt - step - 1e-3);
   EXPECT_LE(found->cpu_seconds, burnt + 0.02);
+}
+
+// Each part's total only grows: a thread that ends keeps what was counted of it, and a new one of
+// the same part adds its own.
+TEST(ThreadCpu, CpuByPartNeverFallsWhenAThreadEnds) {
+  const auto burn_as_helper = [](double seconds) {
+    std::thread([seconds] {
+      name_this_thread("arp-helper");
+      burn(seconds);
+    }).join();
+  };
+  CpuByPart cpu;
+  const double helper_before = cpu.update()["helper"];  // none yet: 0
+  std::atomic<int> stage{0};
+  std::thread first([&] {
+    name_this_thread("arp-helper");
+    burn(0.03);
+    stage = 1;
+    stage.notify_all();
+    stage.wait(1);
+  });
+  stage.wait(0);
+  const double while_alive = cpu.update()["helper"];
+  stage = 2;
+  stage.notify_all();
+  first.join();
+  EXPECT_EQ(helper_before, 0.0);
+  EXPECT_GE(while_alive, 0.03 - 1e-3);
+  const double after_end = cpu.update()["helper"];
+  EXPECT_GE(after_end, while_alive);  // counted once, never taken back
+  burn_as_helper(0.02);               // started and ended between two calls: its time is lost
+  const double next = cpu.update()["helper"];
+  EXPECT_GE(next, after_end);
+  EXPECT_LT(next, after_end + 0.005);
+}
+
+TEST(ThreadCpu, EachThreadNameHasItsPart) {
+  EXPECT_EQ(thread_part("arp-process"), "processing");
+  EXPECT_EQ(thread_part("arp-helper"), "helper");
+  EXPECT_EQ(thread_part("llvmpipe-1"), "gl");
+  EXPECT_EQ(thread_part("arp-capture"), "capture");
+  EXPECT_EQ(thread_part("arp-sinks"), "sinks");
+  EXPECT_EQ(thread_part("arp-sink sinks."), "sinks");
+  EXPECT_EQ(thread_part("arpiped"), "other");
+  EXPECT_EQ(thread_part("arp-sinkhole"), "other");
 }
 
 TEST(ThreadCpu, TheDifferenceBetweenSnapshotsIsSummedByGroup) {
