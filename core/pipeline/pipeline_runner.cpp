@@ -12,8 +12,8 @@
 
 #include "core/log.h"
 #include "core/pipeline/helper_thread.h"
-#include "core/system/thread_cpu.h"
 #include "core/pipeline/monotonic_clock.h"
+#include "core/system/thread_cpu.h"
 
 namespace arpipe {
 

@@ -128,9 +128,8 @@ TEST(LightReplay, MirrorProbeFindsTheLampThroughTheWholeDaemon) {
 
 // The probe measures its still lamp a little differently on every frame (up to 0.18 degrees, 2.1 %
 // in irradiance and 2.5 % in the ambient light from the first frame on this capture): with
-// light.probe.hold_* (0.5 degrees, 5 %) a frame
-// whose measurement is within that of the light handed on keeps it, bit for bit, and its shadow
-// map is reused; only the lamp's estimated size, which grows 7 % over the capture as the camera
+// light.probe.hold_* (0.5 degrees, 5 %) a frame whose measurement is within that of the light
+// handed on keeps it, bit for bit, and its shadow map is reused; only the lamp's estimated size, which grows 7 % over the capture as the camera
 // moves, takes a new light, once (frame 6). With the hold off, no two frames have the same light
 // and every frame draws its shadow map. The lamp stays within 3 cm of the truth either way.
 TEST(LightReplay, AStillLampsLightIsKeptWithinItsNoiseAndItsShadowMapReused) {
