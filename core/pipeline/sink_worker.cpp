@@ -12,7 +12,8 @@ SinkWorker::~SinkWorker() { finish(); }
 
 void SinkWorker::start() {
   thread_ = std::thread([this] {
-    name_this_thread("arp-sink " + key_);
+    // "arp-sink png" for sinks.png: Linux keeps 15 bytes of a name.
+    name_this_thread("arp-sink " + (key_.starts_with("sinks.") ? key_.substr(6) : key_));
     run();
   });
 }

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "core/pipeline/pipeline_runner.h"
+#include "core/pipeline/sink_worker.h"
 #include "core/system/thread_cpu.h"
 
 namespace arpipe {
@@ -439,6 +440,14 @@ TEST(PipelineRunner, ItsThreadsAreNamedForTheirParts) {
               log.threads_at_first_frame.end())
         << name;
   EXPECT_TRUE(log.own_thread_name.starts_with("arp-sink ")) << log.own_thread_name;
+  // A keyed sink's thread takes the key's short name.
+  auto keyed_log = std::make_shared<SinkLog>();
+  {
+    SinkWorker worker("sinks.results", std::make_unique<FakeSink>(keyed_log), 2, OverflowPolicy::Block);
+    worker.start();
+    worker.push(std::make_shared<const FrameContext>());
+  }  // finished: the frame was consumed
+  EXPECT_EQ(keyed_log->own_thread_name, "arp-sink result");  // "arp-sink results", cut to 15 bytes
 }
 
 TEST(PipelineRunner, StageThatHoldsFramesBackSeesTheNextFrameFirstAndNothingIsLost) {
