@@ -86,17 +86,10 @@ std::string thread_part(std::string_view name) {
 }
 
 std::map<std::string, double> CpuByPart::update() {
-  const std::vector<ThreadCpu> now = threads_cpu();
+  std::vector<ThreadCpu> now = threads_cpu();
   std::lock_guard lock(mutex_);
-  std::map<int, double> seen;
-  for (const ThreadCpu& thread : now) {
-    const auto it = last_by_tid_.find(thread.tid);
-    // A tid used again by a thread started since has a smaller counter: it counts whole.
-    const double before = it != last_by_tid_.end() && it->second <= thread.cpu_seconds ? it->second : 0.0;
-    totals_[thread_part(thread.name)] += thread.cpu_seconds - before;
-    seen[thread.tid] = thread.cpu_seconds;
-  }
-  last_by_tid_ = std::move(seen);
+  for (const auto& [part, seconds] : cpu_seconds_between(last_, now, thread_part)) totals_[part] += seconds;
+  last_ = std::move(now);
   return totals_;
 }
 
@@ -108,7 +101,9 @@ std::map<std::string, double> cpu_seconds_between(const std::vector<ThreadCpu>& 
   std::map<std::string, double> out;
   for (const ThreadCpu& thread : after) {
     const auto it = at_start.find(thread.tid);
-    out[group_of(thread.name)] += thread.cpu_seconds - (it == at_start.end() ? 0.0 : it->second);
+    // A tid used again by a thread started since has a smaller counter: it counts whole.
+    const double before = it != at_start.end() && it->second <= thread.cpu_seconds ? it->second : 0.0;
+    out[group_of(thread.name)] += thread.cpu_seconds - before;
   }
   return out;
 }

@@ -46,12 +46,13 @@ class CpuByPart {
 
  private:
   std::mutex mutex_;
-  std::map<int, double> last_by_tid_;
+  std::vector<ThreadCpu> last_;  // the threads at the call before (cpu_seconds_between from it)
   std::map<std::string, double> totals_;
 };
 
 // CPU seconds per thread between two snapshots, by tid (a thread started between them counts from
-// zero; one that ended between them is missing, its time lost). Summed by the group that
+// zero, as does one whose counter is below its earlier reading: a new thread that took the tid;
+// one that ended between them is missing, its time lost). Summed by the group that
 // `group_of` gives each thread's name (thread_part, say).
 std::map<std::string, double> cpu_seconds_between(const std::vector<ThreadCpu>& before,
                                                   const std::vector<ThreadCpu>& after,
