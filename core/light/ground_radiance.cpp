@@ -22,7 +22,7 @@ constexpr int kRingSamples = 96;
 
 std::optional<Vec3> GroundRadiance::measure(const Frame& frame, const CameraModel& camera, const SE3& T_cam_world,
                                             const CameraResponse& response) {
-  std::vector<Vec2> pixels;
+  pixels_.clear();
   for (int i = 0; i < kRingSamples; ++i) {
     const double angle = 2 * kPi * i / kRingSamples;
     const double radius = kRingInner + (kRingOuter - kRingInner) * ((i * 7) % kRingSamples) / double(kRingSamples);
@@ -30,25 +30,15 @@ std::optional<Vec3> GroundRadiance::measure(const Frame& frame, const CameraMode
     if (cam[2] <= 0) continue;
     if (const std::optional<Vec2> q = camera.project(cam))
       if ((*q)[0] >= 0 && (*q)[1] >= 0 && (*q)[0] <= camera.width() - 1 && (*q)[1] <= camera.height() - 1)
-        pixels.push_back(*q);
+        if (const int x = int(std::lround((*q)[0])), y = int(std::lround((*q)[1])); x < frame.width && y < frame.height)
+          pixels_.push_back({x, y});
   }
-  if (int(pixels.size()) < kRingSamples / 4) return std::nullopt;
-  double x0 = 1e9, y0 = 1e9, x1 = -1e9, y1 = -1e9;
-  for (const Vec2& q : pixels) {
-    x0 = std::min(x0, q[0]);
-    y0 = std::min(y0, q[1]);
-    x1 = std::max(x1, q[0]);
-    y1 = std::max(y1, q[1]);
-  }
-  const ImageRect rect{int(x0), int(y0), int(x1) - int(x0) + 1, int(y1) - int(y0) + 1};
-  if (!decode_linear_patch(frame, rect, response, patch_)) return std::nullopt;
+  if (int(pixels_.size()) < kRingSamples / 4) return std::nullopt;
+  // The ring's pixels alone: a rectangle around it would decode most of the frame.
+  if (!decode_linear_pixels(frame, pixels_, response)) return std::nullopt;
   std::vector<std::array<float, 3>> values;
-  for (const Vec2& q : pixels) {
-    const int x = int(std::lround(q[0])), y = int(std::lround(q[1]));
-    if (!patch_.rect.contains(x, y) || patch_.clipped_at(x, y)) continue;
-    const float* rgb = patch_.at(x, y);
-    values.push_back({rgb[0], rgb[1], rgb[2]});
-  }
+  for (const LinearPixel& p : pixels_)
+    if (!p.clipped) values.push_back({p.rgb[0], p.rgb[1], p.rgb[2]});
   if (int(values.size()) < kRingSamples / 4) return std::nullopt;
   Vec3 median{};
   for (size_t c = 0; c < 3; ++c) {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <optional>
+#include <vector>
 
 #include "core/frame.h"
 #include "core/geometry/camera_model.h"
@@ -20,7 +21,7 @@ class GroundRadiance {
                               const CameraResponse& response);
 
  private:
-  LinearPatch patch_;
+  std::vector<LinearPixel> pixels_;  // the ring's, kept for its buffer
 };
 
 // A light whose probe pixels were clipped is only known as a lower bound. The ground it falls on

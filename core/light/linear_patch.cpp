@@ -124,4 +124,28 @@ bool decode_linear_patch(const Frame& frame, const ImageRect& rect_in, const Cam
   return true;
 }
 
+bool decode_linear_pixels(const Frame& frame, std::span<LinearPixel> pixels, const CameraResponse& response) {
+  thread_local LinearPatch patch;
+  const auto take = [&](LinearPixel& p) {
+    if (!patch.rect.contains(p.x, p.y)) return false;
+    const float* rgb = patch.at(p.x, p.y);
+    std::copy(rgb, rgb + 3, p.rgb);
+    p.clipped = patch.clipped_at(p.x, p.y);
+    return true;
+  };
+  if (is_bayer(frame.format)) {  // developed whole whatever the rectangle: one rectangle
+    if (pixels.empty()) return decode_linear_patch(frame, {0, 0, 1, 1}, response, patch);
+    int x0 = pixels[0].x, y0 = pixels[0].y, x1 = x0, y1 = y0;
+    for (const LinearPixel& p : pixels) {
+      x0 = std::min(x0, p.x), y0 = std::min(y0, p.y);
+      x1 = std::max(x1, p.x), y1 = std::max(y1, p.y);
+    }
+    if (!decode_linear_patch(frame, {x0, y0, x1 - x0 + 1, y1 - y0 + 1}, response, patch)) return false;
+    return std::all_of(pixels.begin(), pixels.end(), take);
+  }
+  for (LinearPixel& p : pixels)
+    if (!decode_linear_patch(frame, {p.x, p.y, 1, 1}, response, patch) || !take(p)) return false;
+  return true;
+}
+
 }  // namespace arpipe

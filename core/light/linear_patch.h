@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "core/frame.h"
@@ -39,5 +40,20 @@ struct LinearPatch {
 // Never throws; reuses out's buffers.
 bool decode_linear_patch(const Frame& frame, const ImageRect& rect, const CameraResponse& response,
                          LinearPatch& out);
+
+// One pixel of a frame, decoded as decode_linear_patch decodes it.
+struct LinearPixel {
+  int x = 0, y = 0;  // image pixel, inside the frame
+  float rgb[3] = {0, 0, 0};
+  bool clipped = false;
+};
+
+// Decodes scattered pixels (their x and y filled in) to exactly what decode_linear_patch gives
+// for them, at the cost of the pixels alone: each converts only its own chroma block, where a
+// rectangle around them all would convert every pixel between them (a ring of 96 samples on the
+// ground spans most of the frame). A Bayer frame is developed whole once, as by
+// decode_linear_patch. False, with `pixels` partly written, when the frame or its exposure is
+// unusable or a pixel lies outside the frame. Never throws.
+bool decode_linear_pixels(const Frame& frame, std::span<LinearPixel> pixels, const CameraResponse& response);
 
 }  // namespace arpipe
