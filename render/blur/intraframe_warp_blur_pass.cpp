@@ -15,20 +15,26 @@
 namespace arpipe {
 namespace {
 
-// Per sample: the two warps output -> intraframe, already turned into gl_FragCoord -> texture
-// coordinates (so the shader does one dot product per coordinate), packed into 3 vec4s
-//   [fx0 fx1 fx2 fy0] [fy1 fy2 sx0 sx1] [sx2 sy0 sy1 sy2]   (f: first, s: second; u = dot(x*, (fc, 1)))
-// and the weights two samples to a vec4: 3 * 50 + 25 = 175 uniform vectors, within GLES 3.0's
-// guaranteed 224 (GL_MAX_FRAGMENT_UNIFORM_VECTORS). The bounds test on the texture coordinate
-// ([0, 1] = pixel coordinates [-0.5, size - 0.5]) stands in for clamp-to-border, which GLES 3.0
-// lacks: the edge half-texel reads the edge texel, beyond it reads transparent black.
+// The samples' lookups with a weight above zero, those into the first intraframe first: a sample
+// before the first intraframe reads only it, one after the second only that one, and only those
+// between cross-fade both, so a plan of n samples has n + (the cross-fades) lookups, not 2n. Two
+// loops over them run only those: a software rasteriser runs both sides of a branch on a
+// per-sample weight whatever the weight, and a texture lookup is most of the pass's cost.
+// Per lookup, its warp output -> intraframe, already turned into gl_FragCoord -> texture
+// coordinates (so the shader does one dot product per coordinate), and its weight, in 2 vec4s
+//   [u0 u1 u2 v0] [v1 v2 w -]   (u = dot(u*, (fc, 1)))
+// 2 * 100 + 2 = 202 uniform vectors, within GLES 3.0's guaranteed 224
+// (GL_MAX_FRAGMENT_UNIFORM_VECTORS). The bounds test on the texture coordinate ([0, 1] = pixel
+// coordinates [-0.5, size - 0.5]) stands in for clamp-to-border, which GLES 3.0 lacks: the edge
+// half-texel reads the edge texel, beyond it reads transparent black.
 constexpr std::string_view kFragmentShaderTemplate = R"glsl(#version 300 es
 precision highp float;
 uniform highp sampler2D u_first;
 uniform highp sampler2D u_second;
-uniform int u_count;
-uniform vec4 u_maps[{maps}];
-uniform vec4 u_weights[{weights}];
+uniform int u_first_lookups;   // u_lookups[0, u_first_lookups) read u_first
+uniform int u_lookup_count;    // the rest, up to u_lookup_count, read u_second
+uniform float u_samples;
+uniform vec4 u_lookups[{lookups}];
 out vec4 out_color;
 
 vec4 sample_inside(highp sampler2D image, vec2 uv) {{
@@ -39,21 +45,21 @@ vec4 sample_inside(highp sampler2D image, vec2 uv) {{
 void main() {{
   vec3 at = vec3(gl_FragCoord.xy, 1.0);
   vec4 sum = vec4(0.0);
-  for (int i = 0; i < u_count; ++i) {{
-    vec4 a = u_maps[3 * i], b = u_maps[3 * i + 1], c = u_maps[3 * i + 2];
-    vec4 w4 = u_weights[i / 2];
-    vec2 w = (i % 2 == 0) ? w4.xy : w4.zw;
-    if (w.x != 0.0) sum += w.x * sample_inside(u_first, vec2(dot(a.xyz, at), dot(vec3(a.w, b.xy), at)));
-    if (w.y != 0.0) sum += w.y * sample_inside(u_second, vec2(dot(vec3(b.zw, c.x), at), dot(c.yzw, at)));
+  for (int i = 0; i < u_first_lookups; ++i) {{
+    vec4 a = u_lookups[2 * i], b = u_lookups[2 * i + 1];
+    sum += b.z * sample_inside(u_first, vec2(dot(a.xyz, at), dot(vec3(a.w, b.xy), at)));
   }}
-  out_color = sum / float(u_count);
+  for (int i = u_first_lookups; i < u_lookup_count; ++i) {{
+    vec4 a = u_lookups[2 * i], b = u_lookups[2 * i + 1];
+    sum += b.z * sample_inside(u_second, vec2(dot(a.xyz, at), dot(vec3(a.w, b.xy), at)));
+  }}
+  out_color = sum / u_samples;
 }}
 )glsl";
 
-std::string fragment_shader() {
-  return fmt::format(kFragmentShaderTemplate, fmt::arg("maps", 3 * IntraframeWarpBlurPass::kMaxSamples),
-                     fmt::arg("weights", (IntraframeWarpBlurPass::kMaxSamples + 1) / 2));
-}
+constexpr int kMaxLookups = 2 * IntraframeWarpBlurPass::kMaxSamples;
+
+std::string fragment_shader() { return fmt::format(kFragmentShaderTemplate, fmt::arg("lookups", 2 * kMaxLookups)); }
 
 // The map output pixel p -> intraframe pixel q = M p (pixel centres at integers) as
 // gl_FragCoord f = p + 0.5 -> texture coordinate (q + 0.5) / size: 6 floats, row u then row v.
@@ -104,16 +110,20 @@ void IntraframeWarpBlurPass::run(GLuint first, GLuint second, int width, int hei
     glClearColor(0, 0, 0, 0);
     if (!rect.empty()) glClear(GL_COLOR_BUFFER_BIT);
   } else {
-    std::vector<float> maps(size_t(12 * count)), weights(size_t(4 * ((count + 1) / 2)), 0.0f);
-    for (int i = 0; i < count; ++i) {
-      const IntraframeWarpSample& sample = plan.samples[size_t(i)];
-      const std::array<float, 6> to_first = fragcoord_to_uv(sample.first_from_output, width, height);
-      const std::array<float, 6> to_second = fragcoord_to_uv(sample.second_from_output, width, height);
-      std::copy(to_first.begin(), to_first.end(), maps.begin() + 12 * i);
-      std::copy(to_second.begin(), to_second.end(), maps.begin() + 12 * i + 6);
-      weights[size_t(2 * i)] = float(sample.weight_first);
-      weights[size_t(2 * i + 1)] = float(sample.weight_second);
-    }
+    // The lookups, those into the first intraframe first (see the shader).
+    std::vector<float> lookups;
+    lookups.reserve(size_t(8 * kMaxLookups));
+    const auto add = [&](const Affine2& map, double weight) {
+      const std::array<float, 6> uv = fragcoord_to_uv(map, width, height);
+      lookups.insert(lookups.end(), uv.begin(), uv.end());
+      lookups.insert(lookups.end(), {float(weight), 0.0f});
+    };
+    for (const IntraframeWarpSample& sample : plan.samples)
+      if (sample.weight_first > 0) add(sample.first_from_output, sample.weight_first);
+    const int first_lookups = int(lookups.size() / 8);
+    for (const IntraframeWarpSample& sample : plan.samples)
+      if (sample.weight_second > 0) add(sample.second_from_output, sample.weight_second);
+    const int lookup_count = int(lookups.size() / 8);
     for (const auto& [unit, texture] : {std::pair{GL_TEXTURE0, first}, std::pair{GL_TEXTURE1, second}}) {
       glActiveTexture(GLenum(unit));
       glBindTexture(GL_TEXTURE_2D, texture);
@@ -126,9 +136,10 @@ void IntraframeWarpBlurPass::run(GLuint first, GLuint second, int width, int hei
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_BLEND);
     glUseProgram(program_.id());
-    glUniform1i(program_.uniform("u_count"), count);
-    glUniform4fv(program_.uniform("u_maps"), 3 * count, maps.data());
-    glUniform4fv(program_.uniform("u_weights"), (count + 1) / 2, weights.data());
+    glUniform1i(program_.uniform("u_first_lookups"), first_lookups);
+    glUniform1i(program_.uniform("u_lookup_count"), lookup_count);
+    glUniform1f(program_.uniform("u_samples"), float(count));
+    if (lookup_count > 0) glUniform4fv(program_.uniform("u_lookups"), 2 * lookup_count, lookups.data());
     glBindVertexArray(empty_vertex_array_.get());
     glDrawArrays(GL_TRIANGLES, 0, 3);
     glBindVertexArray(0);

@@ -241,6 +241,25 @@ TEST_F(SeedBlurPassTest, FiftySamplesRunFiftyOneThrow) {
   const std::vector<float> out = render_test::read_rgba_float(pass.texture(), kWidth, kHeight);
   for (size_t i = 0; i < out.size(); ++i)
     ASSERT_NEAR(out[i], texels[i], kHalfFloat * texels[i] + kLeak) << "value " << i;
+  // 50 cross-fades, each weighted (1 - t, t) at t = (i + 0.5) / 50, read both textures: 100
+  // lookups, the most a plan can hold. The first is read one pixel to the right and the second
+  // holds the same texels one pixel to the left, so every lookup reads texel x + 1: a lookup that
+  // took the other texture's warp, or a weight left out, shows.
+  const std::vector<float> shifted = image_of(kWidth, kHeight, [](int x, int y) { return textured(x + 1, y); });
+  GlTexture second_shifted = upload(shifted, kWidth, kHeight);
+  IntraframeWarpPlan fades;
+  for (int i = 0; i < IntraframeWarpBlurPass::kMaxSamples; ++i) {
+    const double t = (i + 0.5) / IntraframeWarpBlurPass::kMaxSamples;
+    fades.samples.push_back(sample(1 - t, t, Affine2::translation({1, 0}), Affine2::identity()));
+  }
+  pass.run(first.get(), second_shifted.get(), kWidth, kHeight, fades, PixelRect::full(kWidth, kHeight));
+  const std::vector<float> faded = render_test::read_rgba_float(pass.texture(), kWidth, kHeight);
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x + 1 < kWidth; ++x)
+      for (int c = 0; c < 4; ++c) {
+        const double expected = at(texels, x + 1, y)[c];  // first at x + 1, second shifted by one: the same texel
+        ASSERT_NEAR(at(faded, x, y)[c], expected, kHalfFloat * expected + kLeak) << x << "," << y << " channel " << c;
+      }
   plan.samples.push_back(plan.samples.back());
   EXPECT_EQ(IntraframeWarpBlurPass::kMaxSamples, 50);
   EXPECT_THROW(pass.run(first.get(), second.get(), kWidth, kHeight, plan, PixelRect::full(kWidth, kHeight)),
