@@ -11,6 +11,10 @@
 // its first frame and never again. The texture holds at least two texels per canvas pixel at the
 // point of the square nearest the camera (baked again, larger, when the camera comes closer), at
 // most kMaxCatcherBakeTexels across (nearer than that, the catcher is drawn per pixel).
+// 2048 across is 8 MB and, on llvmpipe, a bake of about 0.3 s (the first frame of 16 cubes seen
+// from 0.45 m: 342 against 129 ms at 1024); such a scene's square needs 955-1127 texels, so at
+// 1024 it was drawn per pixel on most frames, 72 lookups a pixel: its catcher pass took 7.1 ms a
+// frame, baked 2.3 (docs/BENCHMARKS.md, "Scaling").
 //
 // Each bake is read back once to find its reach: the sky occlusion fades to 0 before the square's
 // edge and a shadow covers part of it, so the catcher draws nothing over much of its square (a
@@ -32,7 +36,7 @@ inline constexpr int kMinCatcherBakeTexels = 64;
 // Texels per canvas pixel at the square's nearest point: 2 keeps the filtered lookup's blur of
 // the contact shadow at the objects' feet to half a pixel.
 inline constexpr double kCatcherBakeTexelsPerPixel = 2.0;
-inline constexpr int kMaxCatcherBakeTexels = 1024;
+inline constexpr int kMaxCatcherBakeTexels = 2048;
 
 // Whether two lights give the ground catcher the same ratio within 1/1000 (a quarter of 1/255).
 // The ratio (A + V D) / (A + D) depends on the light through the luminance of the direct light D,

@@ -84,6 +84,11 @@ TEST(CatcherBake, BakesOnceForAStillLightAndLeavesAChurningOneToThePerPixelPath)
   EXPECT_EQ(bake.bakes(), 5u);
   EXPECT_NE(bake.for_frame(renderer, lighting, catcher, 100, false).texture, 0u) << "farther: the larger one serves";
   EXPECT_EQ(bake.bakes(), 5u);
+  // 16 cubes 7 cm apart seen from 0.45 m need 955-1127 texels across (bench/pipeline_scaling):
+  // their catcher is baked, not drawn per pixel.
+  EXPECT_GE(kMaxCatcherBakeTexels, 1127);
+  EXPECT_NE(bake.for_frame(renderer, lighting, catcher, 1127, false).texture, 0u) << "16 cubes' square: baked";
+  EXPECT_EQ(bake.bakes(), 6u);
   EXPECT_EQ(bake.for_frame(renderer, lighting, catcher, kMaxCatcherBakeTexels + 1, false).texture, 0u)
       << "too close for a bake: per pixel";
   EXPECT_EQ(CatcherBake(false).for_frame(renderer, lighting, catcher, 300, false).texture, 0u) << "no float target";
