@@ -133,8 +133,8 @@ bool decode_linear_pixels(const Frame& frame, std::span<LinearPixel> pixels, con
     p.clipped = patch.clipped_at(p.x, p.y);
     return true;
   };
+  if (pixels.empty()) return decode_linear_patch(frame, {0, 0, 1, 1}, response, patch);  // the frame's checks alone
   if (is_bayer(frame.format)) {  // developed whole whatever the rectangle: one rectangle
-    if (pixels.empty()) return decode_linear_patch(frame, {0, 0, 1, 1}, response, patch);
     int x0 = pixels[0].x, y0 = pixels[0].y, x1 = x0, y1 = y0;
     for (const LinearPixel& p : pixels) {
       x0 = std::min(x0, p.x), y0 = std::min(y0, p.y);

@@ -23,7 +23,7 @@ namespace {
 // Per lookup, its warp output -> intraframe, already turned into gl_FragCoord -> texture
 // coordinates (so the shader does one dot product per coordinate), and its weight, in 2 vec4s
 //   [u0 u1 u2 v0] [v1 v2 w -]   (u = dot(u*, (fc, 1)))
-// 2 * 100 + 2 = 202 uniform vectors, within GLES 3.0's guaranteed 224
+// 2 * 100 = 200 uniform vectors and three scalars, within GLES 3.0's guaranteed 224
 // (GL_MAX_FRAGMENT_UNIFORM_VECTORS). The bounds test on the texture coordinate ([0, 1] = pixel
 // coordinates [-0.5, size - 0.5]) stands in for clamp-to-border, which GLES 3.0 lacks: the edge
 // half-texel reads the edge texel, beyond it reads transparent black.

@@ -66,6 +66,7 @@ TEST(LinearPixels, APixelOutsideTheFrameOrAFrameWithoutExposureIsRefused) {
     EXPECT_TRUE(decode_linear_pixels(frame, inside, response)) << pixel_format_name(format);
     frame.meta.exposure_ns = 0;
     EXPECT_FALSE(decode_linear_pixels(frame, inside, response)) << pixel_format_name(format);
+    EXPECT_FALSE(decode_linear_pixels(frame, std::span<LinearPixel>{}, response)) << "no pixels, still checked";
   }
 }
 
