@@ -86,8 +86,10 @@ std::string thread_part(std::string_view name) {
 }
 
 std::map<std::string, double> CpuByPart::update() {
-  std::vector<ThreadCpu> now = threads_cpu();
+  // The snapshot under the lock: two scrapes at once must not apply an older one after a newer
+  // one (its smaller counters would read as reused tids and count whole).
   std::lock_guard lock(mutex_);
+  std::vector<ThreadCpu> now = threads_cpu();
   for (const auto& [part, seconds] : cpu_seconds_between(last_, now, thread_part)) totals_[part] += seconds;
   last_ = std::move(now);
   return totals_;
